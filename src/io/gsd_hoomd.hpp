@@ -1,0 +1,103 @@
+// HOOMD-schema (version 1.4) frames on top of the GSD file layer: the trajectory and checkpoint
+// format of hardbody, readable by gsd.hoomd, OVITO, freud, HOOMD-blue.
+//
+// Schema rules followed here:
+//  * A chunk missing from frame i > 0 means "as in frame 0" (per-particle arrays: only when N
+//    equals frame 0's N), otherwise the schema default. The writer omits a chunk only when a
+//    reader applying this rule gets exactly the same bytes back; step, box, N, position and all
+//    log chunks are written in every frame.
+//  * particles/types and particles/type_shapes are int8 NT x M arrays of 0-terminated UTF-8
+//    strings (M = longest + 1); type_shapes rows are JSON objects (see gsd "Shape Visualization").
+//  * A log/ chunk present in some frame must be present in frame 0.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string_view>
+#include <string>
+#include <vector>
+
+#include "io/gsd.hpp"
+
+namespace hb::gsd {
+
+inline constexpr Version kHoomdSchemaVersion{1, 4};
+inline constexpr std::string_view kApplication = "hardbody";
+
+// A logged quantity: rows x cols doubles, row-major (stored as a float64 chunk "log/<key>").
+struct LogArray {
+  std::uint64_t rows = 1;
+  std::uint32_t cols = 1;
+  std::vector<double> values;
+};
+
+// One frame. Per-particle arrays are row-major, N rows. For writing, an empty optional array
+// means "not given" (nothing written; a reader sees frame 0's value or the default). read_frame
+// always fills every per-particle array (from the file, frame 0 or the schema default).
+struct HoomdFrame {
+  std::uint64_t step = 0;
+  std::uint8_t dimensions = 3;
+  std::array<float, 6> box{1, 1, 1, 0, 0, 0};  // Lx, Ly, Lz, xy, xz, yz
+  std::uint32_t N = 0;
+  std::vector<float> position;            // N x 3, required
+  std::vector<float> orientation;         // N x 4, [w, x, y, z]; default 1,0,0,0
+  std::vector<std::uint32_t> type_id;     // N (chunk particles/typeid); default 0
+  std::vector<std::string> types;         // NT names; default {"A"}
+  std::vector<std::string> type_shapes;   // NT JSON objects; empty = none defined
+  std::vector<float> velocity;            // N x 3; default 0
+  std::vector<float> angmom;              // N x 4; default 0
+  std::vector<std::int32_t> image;        // N x 3; default 0
+  std::map<std::string, LogArray> log;    // key without the "log/" prefix, e.g. "hardbody/time"
+};
+
+// type_shapes entries (JSON with round-trip precision).
+std::string sphere_shape(double diameter);
+std::string ellipsoid_shape(double a, double b, double c);
+std::string convex_polyhedron_shape(const std::vector<std::array<double, 3>>& vertices,
+                                    double rounding_radius = 0.0);
+
+// A chunk as it goes to the file.
+struct EncodedChunk {
+  Type type = Type::uint8;
+  std::uint64_t N = 0;
+  std::uint32_t M = 1;
+  std::vector<std::byte> bytes;
+  friend bool operator==(const EncodedChunk&, const EncodedChunk&) = default;
+};
+
+// Appends HOOMD frames to a GSD file. Throws std::invalid_argument for an inconsistent frame
+// (array sizes, typeid >= NT, a log key not in frame 0, ...) before anything is written.
+class HoomdWriter {
+ public:
+  static HoomdWriter create(const std::filesystem::path& path);
+  // Continue an existing hoomd-schema file (created by hardbody or any GSD 2.x writer).
+  static HoomdWriter append(const std::filesystem::path& path);
+
+  void write_frame(const HoomdFrame& frame);
+  void sync() { file_.sync(); }
+  void close() { file_.close(); }
+  std::uint64_t nframes() const { return file_.frame(); }
+  const std::filesystem::path& path() const { return file_.path(); }
+
+ private:
+  explicit HoomdWriter(Writer w) : file_(std::move(w)) {}
+
+  Writer file_;
+  std::map<std::string, EncodedChunk> frame0_;  // frame 0's chunks that later frames may omit
+  std::vector<std::string> frame0_logs_;         // log keys of frame 0
+  std::uint32_t frame0_N_ = 0;
+};
+
+// Read frame `frame` of a hoomd-schema file, applying the schema's fallback rules. Throws
+// std::runtime_error naming the file for a wrong schema, a frame out of range, a chunk of the
+// wrong type or shape, typeid >= NT, or a type_shapes row that is not JSON.
+HoomdFrame read_frame(const Reader& file, std::uint64_t frame);
+HoomdFrame read_frame(const std::filesystem::path& path, std::uint64_t frame);
+HoomdFrame read_last_frame(const std::filesystem::path& path);  // throws if there is no frame
+
+// Write a complete one-frame file to path + ".tmp", flush it to disk and rename it over `path`.
+// If anything fails, the temporary file is removed and the previous `path` is untouched.
+void write_frame_atomic(const std::filesystem::path& path, const HoomdFrame& frame);
+
+}  // namespace hb::gsd
