@@ -1,0 +1,325 @@
+#include "io/config.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <toml++/toml.h>
+
+#include <fmt/format.h>
+
+namespace hb {
+
+double ShapeSpec::volume() const {
+  if (type == "sphere") return 4.0 / 3.0 * kPi * radius * radius * radius;
+  const double abc = semi_axes.prod();
+  if (type == "ellipsoid") return 4.0 / 3.0 * kPi * abc;
+  // superquadric |x/a|^n + |y/b|^m + |z/c|^p <= 1
+  const double n = exponents.x(), m = exponents.y(), p = exponents.z();
+  return 8.0 * abc * std::tgamma(1 + 1 / n) * std::tgamma(1 + 1 / m) * std::tgamma(1 + 1 / p) /
+         std::tgamma(1 + 1 / n + 1 / m + 1 / p);
+}
+
+double ShapeSpec::max_semi_axis() const {
+  return type == "sphere" ? radius : semi_axes.maxCoeff();
+}
+
+namespace {
+
+// The schema: section -> key -> kind.
+enum class Kind { Int, Float, String, Bool, Vec3 };
+const std::map<std::string, std::map<std::string, Kind>>& schema() {
+  static const std::map<std::string, std::map<std::string, Kind>> s = {
+      {"system",
+       {{"particles", Kind::Int}, {"packing_fraction", Kind::Float}, {"seed", Kind::Int},
+        {"temperature", Kind::Float}, {"mass", Kind::Float}}},
+      {"shape",
+       {{"type", Kind::String}, {"radius", Kind::Float}, {"semi_axes", Kind::Vec3},
+        {"exponents", Kind::Vec3}, {"inertia", Kind::Float}}},
+      {"run", {{"equilibrate_time", Kind::Float}, {"time", Kind::Float}, {"max_collisions", Kind::Int}}},
+      {"neighbors", {{"method", Kind::String}, {"shell", Kind::Float}}},
+      {"solver", {{"eps_d", Kind::Float}}},
+      {"output",
+       {{"log_interval", Kind::Float}, {"snapshot_interval", Kind::Float},
+        {"checkpoint_interval", Kind::Float}, {"trajectory", Kind::Bool}}},
+  };
+  return s;
+}
+
+const char* kind_name(Kind k) {
+  switch (k) {
+    case Kind::Int: return "an integer";
+    case Kind::Float: return "a number";
+    case Kind::String: return "a string";
+    case Kind::Bool: return "true or false";
+    case Kind::Vec3: return "an array of 3 numbers";
+  }
+  return "?";
+}
+
+std::string where(const std::string& file, const toml::node& n) {
+  const auto& src = n.source();
+  if (src.begin.line > 0) return fmt::format("{}:{}", file, src.begin.line);
+  return file;
+}
+
+struct Reader {
+  const std::string& file;
+  const toml::table& root;
+
+  [[noreturn]] void fail(const toml::node* n, const std::string& key, const std::string& what) const {
+    throw ConfigError(fmt::format("{}: key '{}': {}", n ? where(file, *n) : file, key, what));
+  }
+
+  const toml::node* get(const std::string& sec, const std::string& key) const {
+    const auto* t = root.get_as<toml::table>(sec);
+    return t ? t->get(key) : nullptr;
+  }
+  double num(const toml::node* n, const std::string& key) const {
+    double v;
+    if (auto f = n->value_exact<double>()) v = *f;
+    else if (auto i = n->value_exact<int64_t>()) v = double(*i);
+    else fail(n, key, "must be a number");
+    if (!std::isfinite(v)) fail(n, key, "must be finite (got NaN or infinity)");
+    return v;
+  }
+  void real(const std::string& sec, const std::string& key, double& out) const {
+    if (const auto* n = get(sec, key)) out = num(n, sec + "." + key);
+  }
+  void integer(const std::string& sec, const std::string& key, std::uint64_t& out) const {
+    if (const auto* n = get(sec, key)) {
+      auto i = n->value_exact<int64_t>();
+      if (!i) fail(n, sec + "." + key, "must be an integer");
+      if (*i < 0) fail(n, sec + "." + key, fmt::format("must not be negative (got {})", *i));
+      out = static_cast<std::uint64_t>(*i);
+    }
+  }
+  void string(const std::string& sec, const std::string& key, std::string& out) const {
+    if (const auto* n = get(sec, key)) {
+      auto s = n->value_exact<std::string>();
+      if (!s) fail(n, sec + "." + key, "must be a string");
+      out = *s;
+    }
+  }
+  void boolean(const std::string& sec, const std::string& key, bool& out) const {
+    if (const auto* n = get(sec, key)) {
+      auto b = n->value_exact<bool>();
+      if (!b) fail(n, sec + "." + key, "must be true or false");
+      out = *b;
+    }
+  }
+  void vec3(const std::string& sec, const std::string& key, Vec3& out) const {
+    if (const auto* n = get(sec, key)) {
+      const auto* a = n->as_array();
+      if (!a || a->size() != 3) fail(n, sec + "." + key, "must be an array of 3 numbers");
+      for (int k = 0; k < 3; ++k) out[k] = num(a->get(k), sec + "." + key);
+    }
+  }
+  const toml::node* node(const std::string& sec, const std::string& key) const {
+    return get(sec, key);
+  }
+};
+
+void check_unknown_keys(const std::string& file, const toml::table& root) {
+  const auto& s = schema();
+  for (const auto& [k, v] : root) {
+    const std::string sec(k.str());
+    auto it = s.find(sec);
+    if (it == s.end()) {
+      throw ConfigError(fmt::format("{}: unknown section or key '{}'", where(file, v), sec));
+    }
+    const auto* t = v.as_table();
+    if (!t) throw ConfigError(fmt::format("{}: '{}' must be a table [{}]", where(file, v), sec, sec));
+    for (const auto& [kk, vv] : *t) {
+      const std::string key(kk.str());
+      if (!it->second.count(key))
+        throw ConfigError(fmt::format("{}: unknown key '{}.{}'", where(file, vv), sec, key));
+    }
+  }
+}
+
+// Applies one --set override "section.key=value" to the parsed table.
+void apply_override(toml::table& root, const std::string& ov) {
+  const auto eq = ov.find('=');
+  const auto dot = ov.find('.');
+  if (eq == std::string::npos || dot == std::string::npos || dot > eq)
+    throw ConfigError(fmt::format("--set '{}': expected section.key=value", ov));
+  const std::string sec = ov.substr(0, dot), key = ov.substr(dot + 1, eq - dot - 1);
+  std::string value = ov.substr(eq + 1);
+  toml::table parsed;
+  try {
+    parsed = toml::parse(std::string_view("v = " + value), std::string_view("--set"));
+  } catch (const toml::parse_error&) {
+    // bare words are strings: --set neighbors.method=cells
+    try {
+      parsed = toml::parse(std::string_view("v = \"" + value + "\""), std::string_view("--set"));
+    } catch (const toml::parse_error& e) {
+      throw ConfigError(fmt::format("--set '{}': cannot parse value: {}", ov, e.description()));
+    }
+  }
+  auto* t = root.get_as<toml::table>(sec);
+  if (!t) {
+    root.insert(sec, toml::table{});
+    t = root.get_as<toml::table>(sec);
+  }
+  t->insert_or_assign(key, *parsed.get("v"));
+}
+
+Config validate(const std::string& file, const toml::table& root) {
+  check_unknown_keys(file, root);
+  Reader r{file, root};
+  Config c;
+  c.source = file;
+  for (const char* sec : {"system", "shape", "run"})
+    if (!root.get_as<toml::table>(sec))
+      throw ConfigError(fmt::format("{}: missing section [{}]", file, sec));
+  auto require = [&](const char* sec, const char* key) {
+    if (!r.get(sec, key))
+      throw ConfigError(fmt::format("{}: missing key '{}.{}'", file, sec, key));
+  };
+  require("system", "particles");
+  require("system", "packing_fraction");
+  require("shape", "type");
+  require("run", "time");
+
+  r.integer("system", "particles", c.particles);
+  r.real("system", "packing_fraction", c.packing_fraction);
+  r.integer("system", "seed", c.seed);
+  r.real("system", "temperature", c.temperature);
+  r.real("system", "mass", c.mass);
+  r.string("shape", "type", c.shape.type);
+  r.real("shape", "radius", c.shape.radius);
+  r.vec3("shape", "semi_axes", c.shape.semi_axes);
+  r.vec3("shape", "exponents", c.shape.exponents);
+  r.real("shape", "inertia", c.shape.inertia);
+  r.real("run", "equilibrate_time", c.equilibrate_time);
+  r.real("run", "time", c.time);
+  r.integer("run", "max_collisions", c.max_collisions);
+  r.string("neighbors", "method", c.neighbors_method);
+  r.real("neighbors", "shell", c.shell);
+  r.real("solver", "eps_d", c.eps_d);
+  r.real("output", "log_interval", c.log_interval);
+  r.real("output", "snapshot_interval", c.snapshot_interval);
+  r.real("output", "checkpoint_interval", c.checkpoint_interval);
+  r.boolean("output", "trajectory", c.trajectory);
+
+  auto bad = [&](const char* sec, const char* key, const std::string& what) {
+    r.fail(r.node(sec, key), std::string(sec) + "." + key, what);
+  };
+  if (c.particles == 0) bad("system", "particles", "must be at least 1 (got 0)");
+  if (c.particles > 100000000) bad("system", "particles", "must be at most 1e8");
+  if (!(c.packing_fraction > 0.0)) bad("system", "packing_fraction", "must be positive");
+  if (!(c.temperature > 0.0)) bad("system", "temperature", "must be positive");
+  if (!(c.mass > 0.0)) bad("system", "mass", "must be positive");
+
+  const std::string& t = c.shape.type;
+  if (t == "sphere") {
+    if (r.get("shape", "semi_axes") || r.get("shape", "exponents"))
+      bad("shape", r.get("shape", "semi_axes") ? "semi_axes" : "exponents",
+          "does not apply to shape type 'sphere' (use radius)");
+    if (!(c.shape.radius > 0.0))
+      bad("shape", "radius", fmt::format("must be positive (got {})", c.shape.radius));
+    c.shape.semi_axes = Vec3::Constant(c.shape.radius);
+    // random close packing is 0.64, the densest packing 0.7405
+    if (c.packing_fraction >= 0.74)
+      bad("system", "packing_fraction",
+          fmt::format("{} is not below 0.74 (the densest sphere packing is 0.7405)",
+                      c.packing_fraction));
+  } else if (t == "ellipsoid" || t == "superquadric") {
+    if (r.get("shape", "radius")) bad("shape", "radius", fmt::format("does not apply to shape type '{}' (use semi_axes)", t));
+    if (!r.get("shape", "semi_axes")) throw ConfigError(fmt::format("{}: missing key 'shape.semi_axes'", file));
+    for (int k = 0; k < 3; ++k)
+      if (!(c.shape.semi_axes[k] > 0.0))
+        bad("shape", "semi_axes", "every semi-axis must be positive");
+    if (t == "superquadric") {
+      if (!r.get("shape", "exponents")) throw ConfigError(fmt::format("{}: missing key 'shape.exponents'", file));
+      for (int k = 0; k < 3; ++k)
+        if (!(c.shape.exponents[k] >= 2.0))
+          bad("shape", "exponents", "every exponent must be >= 2 (smooth convex body)");
+    } else if (r.get("shape", "exponents")) {
+      bad("shape", "exponents", "applies only to shape type 'superquadric'");
+    }
+    if (c.packing_fraction >= 0.7707)
+      bad("system", "packing_fraction",
+          fmt::format("{} is not below 0.7707 (the densest known ellipsoid packing)",
+                      c.packing_fraction));
+  } else {
+    bad("shape", "type", fmt::format("unknown shape type '{}' (sphere, ellipsoid, superquadric)", t));
+  }
+  if (r.get("shape", "inertia") && !(c.shape.inertia > 0.0))
+    bad("shape", "inertia", "must be positive");
+  if (c.shape.inertia == 0.0) {
+    const double rmin = c.shape.semi_axes.minCoeff();
+    c.shape.inertia = 0.4 * c.mass * rmin * rmin;
+  }
+  if (c.equilibrate_time < 0.0) bad("run", "equilibrate_time", "must not be negative");
+  if (!(c.time > 0.0)) bad("run", "time", "must be positive");
+  if (c.neighbors_method != "cells" && c.neighbors_method != "nnl")
+    bad("neighbors", "method", fmt::format("must be \"cells\" or \"nnl\" (got \"{}\")", c.neighbors_method));
+  if (!(c.shell > 0.0)) bad("neighbors", "shell", "must be positive");
+  if (!(c.eps_d > 0.0 && c.eps_d < 1.0)) bad("solver", "eps_d", "must be in (0, 1)");
+  if (!(c.log_interval > 0.0)) bad("output", "log_interval", "must be positive");
+  if (!(c.snapshot_interval > 0.0)) bad("output", "snapshot_interval", "must be positive");
+  if (!(c.checkpoint_interval > 0.0)) bad("output", "checkpoint_interval", "must be positive");
+  return c;
+}
+
+}  // namespace
+
+Config parse_config(const std::string& text, const std::string& name,
+                    const std::vector<std::string>& overrides) {
+  toml::table root;
+  try {
+    root = toml::parse(text, name);
+  } catch (const toml::parse_error& e) {
+    throw ConfigError(fmt::format("{}:{}: malformed TOML: {}", name, e.source().begin.line,
+                                  e.description()));
+  }
+  for (const auto& ov : overrides) apply_override(root, ov);
+  return validate(name, root);
+}
+
+Config load_config(const std::string& path, const std::vector<std::string>& overrides) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ConfigError(fmt::format("{}: cannot open config file", path));
+  std::stringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw ConfigError(fmt::format("{}: cannot read config file", path));
+  return parse_config(ss.str(), path, overrides);
+}
+
+std::string to_toml(const Config& c) {
+  auto arr = [](const Vec3& v) { return toml::array{v.x(), v.y(), v.z()}; };
+  toml::table shape;
+  shape.insert("type", c.shape.type);
+  if (c.shape.type == "sphere") {
+    shape.insert("radius", c.shape.radius);
+  } else {
+    shape.insert("semi_axes", arr(c.shape.semi_axes));
+    if (c.shape.type == "superquadric") shape.insert("exponents", arr(c.shape.exponents));
+  }
+  shape.insert("inertia", c.shape.inertia);
+  toml::table root{
+      {"system", toml::table{{"particles", int64_t(c.particles)},
+                             {"packing_fraction", c.packing_fraction},
+                             {"seed", int64_t(c.seed)},
+                             {"temperature", c.temperature},
+                             {"mass", c.mass}}},
+      {"shape", shape},
+      {"run", toml::table{{"equilibrate_time", c.equilibrate_time},
+                          {"time", c.time},
+                          {"max_collisions", int64_t(c.max_collisions)}}},
+      {"neighbors", toml::table{{"method", c.neighbors_method}, {"shell", c.shell}}},
+      {"solver", toml::table{{"eps_d", c.eps_d}}},
+      {"output", toml::table{{"log_interval", c.log_interval},
+                             {"snapshot_interval", c.snapshot_interval},
+                             {"checkpoint_interval", c.checkpoint_interval},
+                             {"trajectory", c.trajectory}}},
+  };
+  std::ostringstream os;
+  os << "# hardbody resolved configuration (every key, defaults filled in)\n" << root << "\n";
+  return os.str();
+}
+
+}  // namespace hb

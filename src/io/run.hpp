@@ -1,0 +1,31 @@
+// `hardbody run`: configuration -> system -> event loop with observers -> output files.
+#pragma once
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace hb {
+
+struct RunOptions {
+  std::string config_path;
+  std::string out_dir;  // empty: ./run-<config stem>
+  std::vector<std::string> overrides;
+  bool resume = false;
+  bool quiet = false;   // no progress line
+};
+
+// Bad input (config, files): exit status 2.
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+// A failure while running (solver failure, overlap found): exit status 3.
+class RunFailure : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Runs the simulation; throws ConfigError / InputError / RunFailure.
+void run_simulation(const RunOptions& opt);
+
+}  // namespace hb

@@ -1,0 +1,28 @@
+// Final overlap check of a sphere configuration, independent of the event machinery: the
+// minimum centre distance over all pairs. Brute force for moderate N; a fresh grid (built
+// here from the positions alone, not the simulation's cell lists) for large N.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "math/types.hpp"
+#include "system/box.hpp"
+
+namespace hb {
+
+struct OverlapReport {
+  std::uint64_t overlaps = 0;   // pairs closer than sigma (1 - tol)
+  double min_distance = kInf;   // smallest surface gap |r_ij| - sigma over close pairs
+  std::uint64_t pairs_checked = 0;
+};
+
+OverlapReport sphere_overlaps_brute(const std::vector<Vec3>& r, const Box& box, double sigma,
+                                    double tol = 1e-10);
+OverlapReport sphere_overlaps_grid(const std::vector<Vec3>& r, const Box& box, double sigma,
+                                   double tol = 1e-10);
+// Brute force up to 20000 bodies, grid beyond.
+OverlapReport sphere_overlaps(const std::vector<Vec3>& r, const Box& box, double sigma,
+                              double tol = 1e-10);
+
+}  // namespace hb

@@ -1,0 +1,44 @@
+// Periodic orthorhombic box [0, L) with minimum-image convention.
+#pragma once
+#include <cmath>
+
+#include "math/types.hpp"
+
+namespace hb {
+
+struct Box {
+  Vec3 L = Vec3::Ones();
+
+  double volume() const { return L.x() * L.y() * L.z(); }
+
+  // Minimum image of a separation vector; valid for any |d| (not only |d| < 1.5 L).
+  Vec3 minimum_image(Vec3 d) const {
+    for (int k = 0; k < 3; ++k) d[k] -= L[k] * std::nearbyint(d[k] / L[k]);
+    return d;
+  }
+  // Minimum image for |d_k| < 1.5 L_k (centres of bodies stored inside or near the box):
+  // one compare per axis, no division. This is the hot path of pair prediction.
+  Vec3 near_image(Vec3 d) const {
+    for (int k = 0; k < 3; ++k) {
+      if (d[k] > 0.5 * L[k]) d[k] -= L[k];
+      else if (d[k] < -0.5 * L[k]) d[k] += L[k];
+    }
+    return d;
+  }
+  // Wrap a position into [0, L); returns the image shift applied (in box lengths).
+  Eigen::Vector3i wrap(Vec3& r) const {
+    Eigen::Vector3i shift(0, 0, 0);
+    for (int k = 0; k < 3; ++k) {
+      const double s = std::floor(r[k] / L[k]);
+      if (s != 0.0) {
+        r[k] -= s * L[k];
+        if (r[k] >= L[k]) r[k] -= L[k];  // rounding of r - s L can land on L itself
+        if (r[k] < 0.0) r[k] = 0.0;
+        shift[k] = static_cast<int>(s);
+      }
+    }
+    return shift;
+  }
+};
+
+}  // namespace hb

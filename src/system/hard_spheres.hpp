@@ -1,0 +1,56 @@
+// Pair model of identical smooth hard spheres (mass m, diameter sigma) for Simulation.
+#pragma once
+#include "collision/sphere.hpp"
+#include "contact/hard_sphere_time.hpp"
+#include "system/box.hpp"
+#include "system/state.hpp"
+
+namespace hb {
+
+struct HardSpheres {
+  double sigma = 1.0;  // diameter
+  double mass = 1.0;
+
+  double interaction_range() const { return sigma; }
+
+  double contact_time(const State& s, const Box& box, std::uint32_t i, std::uint32_t j,
+                      double now) const {
+    // body i is at `now`; j is streamed on the fly from its own time stamp.
+    const Vec3 dr = box.near_image(s.position_at(j, now) - s.r[i]);
+    return sphere_contact_time(dr, s.v[j] - s.v[i], sigma);
+  }
+
+  // Batch form used by the event loop: branch-free over the candidate list, so the CPU does not
+  // mispredict on which pairs approach (about half of them).
+  void contact_times(const State& s, const Box& box, std::uint32_t i, const std::uint32_t* js,
+                     std::size_t n, double now, double* out) const {
+    const Vec3 ri = s.r[i], vi = s.v[i];
+    const double s2 = sigma * sigma;
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::uint32_t j = js[k];
+      const Vec3 dr = box.near_image(s.r[j] + s.v[j] * (now - s.t[j]) - ri);
+      const Vec3 dv = s.v[j] - vi;
+      const double b = dr.dot(dv);
+      const double c = dr.squaredNorm() - s2;
+      const double disc = b * b - dv.squaredNorm() * c;
+      const double t = c / (std::sqrt(std::max(disc, 0.0)) - b);
+      const double tc = c <= 0.0 ? 0.0 : t;
+      out[k] = (b < 0.0 && disc >= 0.0 && j != i) ? tc : kInf;
+    }
+  }
+
+  CollisionRecord collide(State& s, const Box& box, std::uint32_t i, std::uint32_t j,
+                          double now) const {
+    CollisionRecord rec;
+    rec.a = i;
+    rec.b = j;
+    rec.r_AB = box.minimum_image(s.r[j] - s.r[i]);
+    rec.n = rec.r_AB.normalized();
+    const double e0 = s.v[i].squaredNorm() + s.v[j].squaredNorm();
+    rec.J = collide_spheres(s.v[i], s.v[j], rec.n, 1.0 / mass, 1.0 / mass);
+    rec.dE = 0.5 * mass * (s.v[i].squaredNorm() + s.v[j].squaredNorm() - e0);
+    return rec;
+  }
+};
+
+}  // namespace hb

@@ -1,0 +1,51 @@
+// State of all bodies as a structure of arrays with delayed (per-particle) times: body i is
+// stored as it was at its own time t[i] and is streamed forward only when an event touches it.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "math/types.hpp"
+#include "motion/free_flight.hpp"
+
+namespace hb {
+
+struct State {
+  std::vector<Vec3> r;                // position at t[i] (wrapped into the box at events)
+  std::vector<Vec3> v;                // velocity
+  std::vector<Quat> q;                // orientation body -> lab at t[i]
+  std::vector<Vec3> w;                // angular velocity (lab frame)
+  std::vector<double> t;              // time stamp of the stored state
+  std::vector<std::uint32_t> count;   // number of velocity changes (event counter)
+  std::vector<Eigen::Vector3i> image; // periodic images crossed (for unwrapped positions)
+
+  std::size_t size() const { return r.size(); }
+  void resize(std::size_t n) {
+    r.assign(n, Vec3::Zero());
+    v.assign(n, Vec3::Zero());
+    q.assign(n, Quat::Identity());
+    w.assign(n, Vec3::Zero());
+    t.assign(n, 0.0);
+    count.assign(n, 0);
+    image.assign(n, Eigen::Vector3i::Zero());
+  }
+
+  // Position of body i at time `now` (no state change).
+  Vec3 position_at(std::size_t i, double now) const { return r[i] + v[i] * (now - t[i]); }
+  BodyState body(std::size_t i) const { return BodyState{r[i], q[i], v[i], w[i]}; }
+  BodyState body_at(std::size_t i, double now) const {
+    BodyState b = body(i);
+    advance(b, now - t[i]);
+    return b;
+  }
+  // Stream body i forward to `now`.
+  void advance_to(std::size_t i, double now) {
+    const double dt = now - t[i];
+    if (dt != 0.0) {
+      r[i] += v[i] * dt;
+      if (w[i].squaredNorm() != 0.0) q[i] = orientation_at(BodyState{r[i], q[i], v[i], w[i]}, dt);
+      t[i] = now;
+    }
+  }
+};
+
+}  // namespace hb
