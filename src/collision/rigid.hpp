@@ -32,6 +32,7 @@
 // If u.n + grow <= 0 the surfaces are not approaching (a numerically grazing or stale event):
 // no impulse is applied, the record has J = 0 and dE = 0, and the states are left untouched.
 #pragma once
+#include "collision/record.hpp"  // CollisionRecord {time, a, b, J, n, r_AB, dE}
 #include "math/types.hpp"
 #include "motion/free_flight.hpp"
 
@@ -109,14 +110,6 @@ inline Vec3 angular_momentum(const BodyState& b, const MassProperties& p, const 
   return p.mass * (b.r - P).cross(b.v) + p.apply_inertia(b.q, b.w);
 }
 
-// What a collision did; observers (pressure virial, counts, energy checks) read only this.
-struct CollisionRecord {
-  double J = 0.0;             // impulse magnitude on B along n (>= 0; 0: nothing applied)
-  Vec3 n = Vec3::Zero();      // unit normal from A into B
-  Vec3 r_AB = Vec3::Zero();   // minimum-image r_B - r_A used for the lever arms
-  double dE = 0.0;            // kinetic-energy change: 0 to rounding if grow = 0, else J*grow
-};
-
 // Contact relative velocity u = (v_A + w_A x rA) - (v_B + w_B x rB) with rA = x_C - r_A,
 // rB = x_C - (r_A + r_AB).  x_C is given in A's periodic image (near A.r).
 inline Vec3 contact_relative_velocity(const BodyState& A, const BodyState& B, const Vec3& x_C,
@@ -127,6 +120,8 @@ inline Vec3 contact_relative_velocity(const BodyState& A, const BodyState& B, co
 }
 
 // Resolve a collision in place (v and w of A and B change; r and q do not).
+// Returns the record with J, n, r_AB, dE filled (J >= 0 on B along n; dE: 0 to rounding if
+// grow = 0, else J*grow); time, a, b are left for the caller.
 //   x_C   contact point, in A's periodic image (i.e. near A.r; B is taken at A.r + r_AB).
 //   n     normal from A into B (normalised here; must be non-zero and finite).
 //   r_AB  minimum-image separation r_B - r_A.  B.r itself is NOT used, so B may be stored

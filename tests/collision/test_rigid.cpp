@@ -1,6 +1,7 @@
 // Elastic collision of rigid bodies: conservation laws, reversal of the normal contact
 // velocity, the hard-sphere limit, periodic images and the growth rule.
 #include "collision/rigid.hpp"
+#include "collision/sphere.hpp"
 
 #include <gtest/gtest.h>
 
@@ -236,6 +237,33 @@ TEST(RigidCollision, SphereCaseIsTheHardSphereRuleAndKeepsSpins) {
     // the lever arm is parallel to n: rA x n is ~1e-16 and the spins barely move
     EXPECT_LT((A.w - wA0).norm(), 1e-14 * (1 + wA0.norm()));
     EXPECT_LT((B.w - wB0).norm(), 1e-14 * (1 + wB0.norm()));
+  }
+}
+
+// The rigid-body rule with the contact on the line of centres agrees with the project's
+// hard-sphere fast path (collision/sphere.hpp), with and without growth.
+TEST(RigidCollision, AgreesWithTheHardSphereFastPath) {
+  std::mt19937_64 g(kSeed + 9);
+  std::uniform_real_distribution<double> U(0.3, 2.0), G(0.0, 0.5);
+  std::normal_distribution<double> N(0.0, 1.0);
+  for (int i = 0; i < 1000; ++i) {
+    const double RA = U(g), RB = U(g), mA = U(g), mB = U(g), grow = (i % 2) ? G(g) : 0.0;
+    BodyState A, B;
+    const Vec3 n = random_unit(g);
+    B.r = A.r + (RA + RB) * n;
+    A.v = Vec3(N(g), N(g), N(g));
+    B.v = Vec3(N(g), N(g), N(g));
+    if ((A.v - B.v).dot(n) + grow <= 0) std::swap(A.v, B.v);
+    if ((A.v - B.v).dot(n) + grow <= 0) continue;
+    Vec3 vA = A.v, vB = B.v;
+    const double J = collide_spheres(vA, vB, n, 1.0 / mA, 1.0 / mB, grow);
+    const CollisionRecord rec =
+        collide(A, MassProperties::spherical_top(mA, 0.4 * mA * RA * RA), B,
+                MassProperties::spherical_top(mB, 0.4 * mB * RB * RB), A.r + RA * n, n,
+                B.r - A.r, grow);
+    EXPECT_NEAR(rec.J, J, 1e-14 * (mA + mB) * (vA.norm() + vB.norm() + 1));
+    EXPECT_LT((A.v - vA).norm(), 1e-14 * (1 + vA.norm()));
+    EXPECT_LT((B.v - vB).norm(), 1e-14 * (1 + vB.norm()));
   }
 }
 
