@@ -1,0 +1,100 @@
+"""Contract of `hardbody run`: outputs, summary keys, and exit status 2 with one clear message
+for bad input, leaving nothing behind."""
+import json
+import os
+import subprocess
+from pathlib import Path
+
+import pytest
+
+HB = os.environ.get("HARDBODY", "hardbody")
+EXAMPLES = Path(os.environ.get("HARDBODY_EXAMPLES", "examples"))
+
+GOOD = """
+[system]
+particles = 256
+packing_fraction = 0.3
+seed = 3
+[shape]
+type = "sphere"
+radius = 0.5
+[run]
+equilibrate_time = 0.5
+time = 2.0
+[output]
+log_interval = 0.25
+"""
+
+SUMMARY_KEYS = ["particles", "packing_fraction", "box", "shape", "time", "collisions",
+                "wall_seconds", "cpu_seconds", "collisions_per_second", "tau_c_us", "Z",
+                "Z_error", "collision_rate", "temperature", "energy_drift", "overlaps",
+                "min_distance", "events", "solver_fallbacks"]
+
+
+def run(args, cwd):
+    return subprocess.run([HB, *args], cwd=cwd, capture_output=True, text=True, timeout=300)
+
+
+def test_run_writes_contract_outputs(tmp_path):
+    cfg = tmp_path / "small.toml"
+    cfg.write_text(GOOD)
+    r = run(["run", str(cfg)], tmp_path)
+    assert r.returncode == 0, r.stderr
+    out = tmp_path / "run-small"
+    for name in ["config.resolved.toml", "log.tsv", "summary.json"]:
+        assert (out / name).is_file(), name
+    assert not list(out.glob("*.tmp")) and not list(out.glob("*.part"))
+    s = json.loads((out / "summary.json").read_text())
+    for k in SUMMARY_KEYS:
+        assert k in s, k
+    assert s["particles"] == 256 and s["overlaps"] == 0 and s["collisions"] > 0
+    assert abs(s["time"] - 2.0) < 1e-9
+    rows = (out / "log.tsv").read_text().strip().splitlines()
+    assert rows[0].startswith("time\t") and len(rows) == 1 + 8
+    # the resolved config runs again as is
+    r2 = run(["run", str(out / "config.resolved.toml"), "--out", str(tmp_path / "again")], tmp_path)
+    assert r2.returncode == 0, r2.stderr
+    s2 = json.loads((tmp_path / "again" / "summary.json").read_text())
+    assert s2["collisions"] == s["collisions"] and s2["Z"] == s["Z"]  # same seed, same run
+
+
+def test_set_override_and_out(tmp_path):
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(GOOD)
+    r = run(["run", str(cfg), "--out", "o", "--set", "system.particles=108", "--set", "run.time=1"], tmp_path)
+    assert r.returncode == 0, r.stderr
+    s = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert s["particles"] == 108
+
+
+BAD = [
+    ("missing file", None, "cannot open config file"),
+    ("malformed", GOOD.replace("seed = 3", "seed = = 3"), "malformed TOML"),
+    ("unknown key", GOOD.replace("seed = 3", "colour = 3"), "unknown key 'system.colour'"),
+    ("wrong type", GOOD.replace("particles = 256", "particles = \"256\""), "system.particles"),
+    ("negative radius", GOOD.replace("radius = 0.5", "radius = -1.0"), "shape.radius"),
+    ("zero radius", GOOD.replace("radius = 0.5", "radius = 0"), "shape.radius"),
+    ("phi >= 0.74", GOOD.replace("packing_fraction = 0.3", "packing_fraction = 0.75"), "system.packing_fraction"),
+    ("N = 0", GOOD.replace("particles = 256", "particles = 0"), "system.particles"),
+    ("too dense for lattice", GOOD.replace("particles = 256", "particles = 250").replace("0.3", "0.73"), "system.packing_fraction"),
+    ("box too small", GOOD.replace("particles = 256", "particles = 2"), "system.particles"),
+]
+
+
+@pytest.mark.parametrize("name,text,expect", BAD, ids=[b[0] for b in BAD])
+def test_bad_input_exits_2_and_writes_nothing(tmp_path, name, text, expect):
+    cfg = tmp_path / "bad.toml"
+    if text is not None:
+        cfg.write_text(text)
+    r = run(["run", str(cfg)], tmp_path)
+    assert r.returncode == 2, (r.returncode, r.stderr)
+    lines = [l for l in r.stderr.strip().splitlines() if l]
+    assert len(lines) == 1, r.stderr
+    assert expect in lines[0], lines[0]
+    assert "bad.toml" in lines[0]
+    assert not (tmp_path / "run-bad").exists()
+
+
+def test_unknown_option_exits_2(tmp_path):
+    r = run(["run", "--bogus"], tmp_path)
+    assert r.returncode == 2

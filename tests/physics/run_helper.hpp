@@ -1,0 +1,50 @@
+// Runs `hardbody run` in-process on a config text and returns the parsed summary.json.
+#pragma once
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "io/run.hpp"
+
+namespace hbtest {
+
+inline nlohmann::json run_config(const std::string& name, const std::string& text,
+                                 const std::vector<std::string>& overrides = {}) {
+  const auto dir = std::filesystem::temp_directory_path() / ("hardbody-test-" + name);
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const auto cfg = dir / (name + ".toml");
+  std::ofstream(cfg) << text;
+  hb::RunOptions opt;
+  opt.config_path = cfg.string();
+  opt.out_dir = (dir / "out").string();
+  opt.overrides = overrides;
+  opt.quiet = true;
+  hb::run_simulation(opt);
+  std::ifstream in(dir / "out" / "summary.json");
+  return nlohmann::json::parse(in);
+}
+
+// Hansen-Goos (J. Chem. Phys. 144, 164506 (2016)) hard-sphere equation of state,
+// ../shared/reference/README.md; accurate to ~1e-4 in the fluid.
+inline double z_hansen_goos(double phi) {
+  const double b[8] = {9, -19, 47.0 / 3.0, -2.635232, -1.265575, 0.041212, 0.248245, -0.096495};
+  double s = 0.0, p = 1.0;
+  for (double bk : b) s += bk * p, p *= phi;
+  const double q = 1.0 - phi;
+  return 8.0 * std::log(q) / phi + s / (q * q * q);
+}
+
+inline std::string sphere_config(int n, double phi, double teq, double t, int seed = 1,
+                                 double log_interval = 0.1) {
+  return "[system]\nparticles = " + std::to_string(n) + "\npacking_fraction = " +
+         std::to_string(phi) + "\nseed = " + std::to_string(seed) +
+         "\n[shape]\ntype = \"sphere\"\nradius = 0.5\n[run]\nequilibrate_time = " +
+         std::to_string(teq) + "\ntime = " + std::to_string(t) +
+         "\n[output]\nlog_interval = " + std::to_string(log_interval) + "\n";
+}
+
+}  // namespace hbtest
