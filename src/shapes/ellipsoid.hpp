@@ -1,0 +1,75 @@
+// Ellipsoid with semi-axes (a, b, c) along body x, y, z (uniaxial or triaxial), and the sphere.
+//
+//   f(x) = x^T X x - 1,  X = diag(a^-2, b^-2, c^-2)        (ERRATA 2: squares, and the "- 1")
+//   grad f = 2 X x,  Hessian = 2 X  (constant)
+//   volume = 4/3 pi a b c,  bounding radius = max(a,b,c),  inscribed radius = min(a,b,c)
+//   ray from the centre along u: s u with s = 1 / sqrt(u^T X u)
+//   support h(n) = sqrt(n^T M n), M = diag(a^2, b^2, c^2) = X^-1; support point M n / h(n)
+//   (the surface point whose outward normal 2 X p = 2 n / h is parallel to n);
+//   Hessian of h: (M - (M n)(M n)^T / h^2) / h.
+//
+// The sphere uses the same scaled form f = |x|^2 / r^2 - 1 so that a sphere and an ellipsoid
+// with a = b = c = r are the same function (the generic solvers see identical input).
+#pragma once
+#include <algorithm>
+#include <cmath>
+
+#include "math/types.hpp"
+#include "shapes/shape.hpp"
+
+namespace hb {
+
+struct Ellipsoid {
+  double a = 1.0, b = 1.0, c = 1.0;
+
+  Vec3 inv_sq() const { return Vec3(1.0 / (a * a), 1.0 / (b * b), 1.0 / (c * c)); }
+  Vec3 sq() const { return Vec3(a * a, b * b, c * c); }
+
+  double f(const Vec3& x) const { return x.cwiseProduct(x).dot(inv_sq()) - 1.0; }
+  Vec3 grad(const Vec3& x) const { return 2.0 * x.cwiseProduct(inv_sq()); }
+  Mat3 hessian(const Vec3& /*x*/) const { return Mat3(2.0 * inv_sq().asDiagonal()); }
+
+  double volume() const { return 4.0 / 3.0 * kPi * a * b * c; }
+  double bounding_radius() const { return std::max({a, b, c}); }
+  double inscribed_radius() const { return std::min({a, b, c}); }
+  Vec3 half_extents() const { return Vec3(a, b, c); }
+  Vec3 ray_surface(const Vec3& u) const {
+    return u / std::sqrt(u.cwiseProduct(u).dot(inv_sq()));
+  }
+
+  double support(const Vec3& n) const { return std::sqrt(n.cwiseProduct(n).dot(sq())); }
+  Vec3 support_point(const Vec3& n) const { return n.cwiseProduct(sq()) / support(n); }
+  Mat3 support_hessian(const Vec3& n) const {
+    const double h = support(n);
+    const Vec3 mn = n.cwiseProduct(sq());
+    return (Mat3(sq().asDiagonal()) - mn * mn.transpose() / (h * h)) / h;
+  }
+};
+
+struct Sphere {
+  double radius = 1.0;
+
+  double f(const Vec3& x) const { return x.squaredNorm() / (radius * radius) - 1.0; }
+  Vec3 grad(const Vec3& x) const { return (2.0 / (radius * radius)) * x; }
+  Mat3 hessian(const Vec3& /*x*/) const {
+    return Mat3::Identity() * (2.0 / (radius * radius));
+  }
+
+  double volume() const { return 4.0 / 3.0 * kPi * radius * radius * radius; }
+  double bounding_radius() const { return radius; }
+  double inscribed_radius() const { return radius; }
+  Vec3 half_extents() const { return Vec3::Constant(radius); }
+  Vec3 ray_surface(const Vec3& u) const { return u * (radius / u.norm()); }
+
+  double support(const Vec3& n) const { return radius * n.norm(); }
+  Vec3 support_point(const Vec3& n) const { return n * (radius / n.norm()); }
+  Mat3 support_hessian(const Vec3& n) const {
+    const double nn = n.norm();
+    return (radius / nn) * (Mat3::Identity() - n * n.transpose() / (nn * nn));
+  }
+};
+
+static_assert(SupportShape<Ellipsoid>);
+static_assert(SupportShape<Sphere>);
+
+}  // namespace hb

@@ -1,0 +1,69 @@
+// The shape concept: what a convex body must supply to the generic distance and contact-time
+// solvers.  Everything is in the body frame (centre at the origin, semi-axes along x, y, z).
+//
+// A shape is described by a smooth implicit function f(x): f < 0 inside, f = 0 on the surface,
+// f > 0 outside, whose sub-level set {f <= 0} is convex.  The solvers need f, its gradient and
+// its Hessian (Eqs. dist8, dist5, contime of the paper), a bounding radius L (Eq. lalb, for the
+// bounding-sphere bracket and the distance-rate bound, Eq. distOver), an inscribed radius (a
+// length scale for tolerances), the half-extents along the body axes (for the scaled initial
+// guess of section 3.2) and the intersection of a ray from the centre with the surface (for the
+// initial guesses).  Shapes with a closed-form support function h(n) = max_{x in body} n.x
+// additionally model `SupportShape`; that gives the analytic body-plane distance and the
+// independent reference distance used in the tests.
+//
+// Adding a shape (e.g. a superquadric) means writing one small struct with these members: no
+// virtual calls, the solvers are templates over the concept.
+#pragma once
+#include <cmath>
+#include <concepts>
+
+#include "math/types.hpp"
+
+namespace hb {
+
+template <class S>
+concept Shape = requires(const S& s, const Vec3& x) {
+  { s.f(x) } -> std::convertible_to<double>;
+  { s.grad(x) } -> std::convertible_to<Vec3>;
+  { s.hessian(x) } -> std::convertible_to<Mat3>;
+  { s.volume() } -> std::convertible_to<double>;
+  { s.bounding_radius() } -> std::convertible_to<double>;   // L >= max |x| over the body
+  { s.inscribed_radius() } -> std::convertible_to<double>;  // <= min |x| over the surface
+  { s.half_extents() } -> std::convertible_to<Vec3>;        // (a, b, c) along body x, y, z
+  { s.ray_surface(x) } -> std::convertible_to<Vec3>;        // surface point s*x, s > 0
+};
+
+// Closed-form support function h(n) = max_{x in body} n.x (n need not be unit; h is positively
+// homogeneous of degree 1), its gradient (the support point, a surface point with outward
+// normal parallel to n) and its Hessian (for the reference optimiser in the tests).
+template <class S>
+concept SupportShape = Shape<S> && requires(const S& s, const Vec3& n) {
+  { s.support(n) } -> std::convertible_to<double>;
+  { s.support_point(n) } -> std::convertible_to<Vec3>;
+  { s.support_hessian(n) } -> std::convertible_to<Mat3>;
+};
+
+// Ray-surface intersection for any shape: the root s > 0 of phi(s) = f(s u), |u| = 1, on the
+// bracket [inscribed_radius, bounding_radius] (phi is negative below and positive above).
+// Safeguarded Newton (bisection whenever a Newton step leaves the bracket).  Shapes with a
+// closed form (sphere, ellipsoid) do not use it; it is here for shapes that may not have one.
+template <Shape S>
+Vec3 ray_surface_generic(const S& s, const Vec3& dir) {
+  const Vec3 u = dir.normalized();
+  double lo = 0.999 * s.inscribed_radius(), hi = 1.001 * s.bounding_radius();
+  double x = 0.5 * (lo + hi);
+  for (int it = 0; it < 200; ++it) {
+    const Vec3 p = x * u;
+    const double phi = s.f(p);
+    if (phi == 0.0) break;
+    (phi < 0.0 ? lo : hi) = x;
+    const double dphi = s.grad(p).dot(u);
+    double xn = (dphi > 0.0) ? x - phi / dphi : 0.5 * (lo + hi);
+    if (!(xn > lo && xn < hi)) xn = 0.5 * (lo + hi);
+    if (std::abs(xn - x) <= 1e-15 * hi) { x = xn; break; }
+    x = xn;
+  }
+  return x * u;
+}
+
+}  // namespace hb

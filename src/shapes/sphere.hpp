@@ -1,0 +1,3 @@
+// Sphere{radius}: defined with the ellipsoid (same quadratic form), see ellipsoid.hpp.
+#pragma once
+#include "shapes/ellipsoid.hpp"

@@ -1,0 +1,131 @@
+// Shape concept: f, gradient, Hessian against finite differences; volume; ray intersection;
+// support function against its definition.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "shapes/ellipsoid.hpp"
+#include "shapes/shape.hpp"
+
+namespace hb {
+namespace {
+
+std::mt19937_64& rng() {
+  static std::mt19937_64 g(20240611);
+  return g;
+}
+double uni(double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng()); }
+Vec3 rand_vec(double s) { return Vec3(uni(-s, s), uni(-s, s), uni(-s, s)); }
+
+template <Shape S>
+void check_derivatives(const S& s, int samples) {
+  const double L = s.bounding_radius();
+  for (int k = 0; k < samples; ++k) {
+    const Vec3 x = rand_vec(1.5 * L);
+    const double h = 1e-5 * L;
+    Vec3 g_fd;
+    Mat3 h_fd;
+    for (int i = 0; i < 3; ++i) {
+      Vec3 e = Vec3::Zero();
+      e[i] = h;
+      g_fd[i] = (s.f(x + e) - s.f(x - e)) / (2 * h);
+      h_fd.col(i) = (s.grad(x + e) - s.grad(x - e)) / (2 * h);
+    }
+    const Vec3 g = s.grad(x);
+    const Mat3 H = s.hessian(x);
+    EXPECT_LE((g - g_fd).norm(), 1e-6 * g.norm() + 1e-12) << x.transpose();
+    EXPECT_LE((H - h_fd).norm(), 1e-6 * H.norm()) << x.transpose();
+  }
+}
+
+template <SupportShape S>
+void check_support(const S& s, int samples) {
+  for (int k = 0; k < samples; ++k) {
+    const Vec3 n = rand_vec(1.0);
+    const Vec3 p = s.support_point(n);
+    EXPECT_NEAR(s.f(p), 0.0, 1e-13);                            // on the surface
+    EXPECT_NEAR(p.dot(n), s.support(n), 1e-13 * n.norm() * s.bounding_radius());
+    EXPECT_GT(s.grad(p).normalized().dot(n.normalized()), 1.0 - 1e-13);  // normal along n
+    // h is the max of n.x over the body: no random surface point does better
+    for (int j = 0; j < 20; ++j) {
+      const Vec3 q = s.ray_surface(rand_vec(1.0));
+      EXPECT_LE(q.dot(n), s.support(n) * (1 + 1e-14));
+    }
+    // support_point is the gradient of h, support_hessian its Hessian
+    const double h = 1e-6;
+    Mat3 hfd;
+    for (int i = 0; i < 3; ++i) {
+      Vec3 e = Vec3::Zero();
+      e[i] = h;
+      EXPECT_NEAR((s.support(n + e) - s.support(n - e)) / (2 * h), p[i],
+                  1e-7 * s.bounding_radius());
+      hfd.col(i) = (s.support_point(n + e) - s.support_point(n - e)) / (2 * h);
+    }
+    EXPECT_LE((hfd - s.support_hessian(n)).norm(), 1e-6 * s.support_hessian(n).norm() + 1e-9);
+  }
+}
+
+template <Shape S>
+void check_ray(const S& s, int samples) {
+  for (int k = 0; k < samples; ++k) {
+    const Vec3 u = rand_vec(1.0);
+    const Vec3 p = s.ray_surface(u);
+    EXPECT_NEAR(s.f(p), 0.0, 1e-13);
+    EXPECT_GT(p.normalized().dot(u.normalized()), 1.0 - 1e-14);  // along u, forward
+    const Vec3 q = ray_surface_generic(s, u);
+    EXPECT_LE((p - q).norm(), 1e-13 * s.bounding_radius());
+    EXPECT_LE(p.norm(), s.bounding_radius() * (1 + 1e-14));
+    EXPECT_GE(p.norm(), s.inscribed_radius() * (1 - 1e-14));
+  }
+}
+
+TEST(Shapes, SphereDerivativesRaySupport) {
+  const Sphere s{0.7};
+  check_derivatives(s, 200);
+  check_ray(s, 200);
+  check_support(s, 200);
+  EXPECT_LT(s.f(Vec3::Zero()), 0.0);
+  EXPECT_NEAR(s.f(Vec3(0.7, 0, 0)), 0.0, 1e-15);
+}
+
+TEST(Shapes, EllipsoidDerivativesRaySupport) {
+  for (const Ellipsoid e : {Ellipsoid{2.0, 1.0, 1.0}, Ellipsoid{0.5, 1.0, 1.0},
+                            Ellipsoid{0.3, 1.7, 4.0}, Ellipsoid{10.0, 1.0, 0.1}}) {
+    check_derivatives(e, 200);
+    check_ray(e, 200);
+    check_support(e, 200);
+    EXPECT_NEAR(e.f(Vec3(e.a, 0, 0)), 0.0, 1e-15);
+    EXPECT_NEAR(e.f(Vec3(0, e.b, 0)), 0.0, 1e-15);
+    EXPECT_NEAR(e.f(Vec3(0, 0, e.c)), 0.0, 1e-15);
+    EXPECT_DOUBLE_EQ(e.f(Vec3::Zero()), -1.0);
+  }
+}
+
+TEST(Shapes, Volume) {
+  EXPECT_NEAR(Sphere{2.0}.volume(), 32.0 / 3.0 * kPi, 1e-12);
+  EXPECT_NEAR((Ellipsoid{1.0, 2.0, 3.0}.volume()), 8.0 * kPi, 1e-12);
+  // Monte Carlo over the bounding box with a fixed seed: the fraction inside.
+  const Ellipsoid e{0.4, 1.3, 0.8};
+  std::mt19937_64 g(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const int n = 400000;
+  int inside = 0;
+  for (int i = 0; i < n; ++i)
+    if (e.f(Vec3(u(g) * e.a, u(g) * e.b, u(g) * e.c)) < 0) ++inside;
+  const double box = 8.0 * e.a * e.b * e.c;
+  EXPECT_NEAR(box * inside / n, e.volume(), 0.01 * e.volume());
+}
+
+TEST(Shapes, BoundingAndInscribedRadius) {
+  const Ellipsoid e{0.3, 1.7, 4.0};
+  EXPECT_EQ(e.bounding_radius(), 4.0);
+  EXPECT_EQ(e.inscribed_radius(), 0.3);
+  for (int k = 0; k < 1000; ++k) {
+    const double r = e.ray_surface(rand_vec(1.0)).norm();
+    EXPECT_LE(r, 4.0 * (1 + 1e-15));
+    EXPECT_GE(r, 0.3 * (1 - 1e-15));
+  }
+}
+
+}  // namespace
+}  // namespace hb
