@@ -7,6 +7,10 @@
 //   OUT_DIR/big.gsd          300 frames, 101 names: index and namelist outgrow their first blocks
 //                            (frame f: "value" = uint64 [f, 7], "grow/.../<f % 100>" = int32 [-f])
 //   OUT_DIR/expected.json    {"trajectory": [frame...], "checkpoint": frame, "big": {...}}
+//
+// usage: gsd_sample_writer --dump FILE
+//   prints every frame of FILE as read by hb::gsd::read_frame, as JSON (same keys as above), to
+//   check hardbody's reader on files written by the reference implementation.
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -38,15 +42,24 @@ nlohmann::json to_json(const HoomdFrame& f) {
   return j;
 }
 
+int dump(const std::filesystem::path& file) {
+  const hb::gsd::Reader r(file);
+  nlohmann::json frames = nlohmann::json::array();
+  for (std::uint64_t i = 0; i < r.nframes(); ++i) frames.push_back(to_json(read_frame(r, i)));
+  std::printf("%s\n", frames.dump().c_str());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 2) {
-    std::fprintf(stderr, "usage: %s OUT_DIR\n", argv[0]);
+  if (argc != 2 && !(argc == 3 && std::string(argv[1]) == "--dump")) {
+    std::fprintf(stderr, "usage: %s OUT_DIR | --dump FILE\n", argv[0]);
     return 2;
   }
-  const std::filesystem::path dir = argv[1];
   try {
+    if (argc == 3) return dump(argv[2]);
+    const std::filesystem::path dir = argv[1];
     std::filesystem::create_directories(dir);
     std::vector<HoomdFrame> frames = {
         sample_frame(0, 5, 1),

@@ -18,10 +18,15 @@ import gsd.pygsd as gsd_pygsd
 
 
 @pytest.fixture(scope="module")
-def sample(tmp_path_factory):
-    writer = os.environ.get("HB_GSD_SAMPLE_WRITER")
-    if not writer:
+def writer():
+    path = os.environ.get("HB_GSD_SAMPLE_WRITER")
+    if not path:
         pytest.fail("HB_GSD_SAMPLE_WRITER is not set (run through ctest)")
+    return path
+
+
+@pytest.fixture(scope="module")
+def sample(writer, tmp_path_factory):
     out = tmp_path_factory.mktemp("gsd")
     subprocess.run([writer, str(out)], check=True)
     with open(out / "expected.json") as f:
@@ -157,3 +162,47 @@ def test_grown_index_and_namelist(sample):
             name = big["prefix"] + str(i % big["names"])
             numpy.testing.assert_array_equal(f.read_chunk(frame=i, name=name), [-i])
             assert not f.chunk_exists(frame=i, name=big["prefix"] + str((i + 1) % big["names"]))
+
+
+def test_hardbody_reads_reference_files(writer, tmp_path):
+    """hardbody's reader on a file from gsd.hoomd: same values as gsd.hoomd reads back."""
+    path = tmp_path / "reference.gsd"
+    rng = numpy.random.default_rng(5)
+    with gsd_hoomd.open(name=str(path), mode="wb") as traj:
+        for i, N in enumerate([4, 4, 2, 2]):
+            snap = gsd_hoomd.Snapshot()
+            snap.configuration.step = 10 * i
+            snap.configuration.box = [3, 4, 5, 0, 0.5, 0]
+            snap.particles.N = N
+            snap.particles.types = ["A", "a_longer_name"]
+            snap.particles.type_shapes = [{"type": "Sphere", "diameter": 1.5},
+                                          {"type": "Ellipsoid", "a": 1.0, "b": 2.0, "c": 0.25}]
+            snap.particles.typeid = numpy.arange(N, dtype=numpy.uint32) % 2
+            snap.particles.position = rng.random((N, 3), dtype=numpy.float32)
+            if i != 1:  # frame 1 falls back to frame 0's orientation
+                q = rng.random((N, 4))
+                snap.particles.orientation = (q / numpy.linalg.norm(q, axis=1)[:, None]).astype(
+                    numpy.float32)
+            snap.particles.velocity = rng.random((N, 3), dtype=numpy.float32)
+            snap.log["hardbody/time"] = numpy.array([0.1 * i + 1e-12])
+            snap.log["particles/hardbody/x"] = rng.random((N, 3))
+            traj.append(snap)
+    result = subprocess.run([writer, "--dump", str(path)], check=True, capture_output=True,
+                            text=True)
+    frames = json.loads(result.stdout)
+    with gsd_hoomd.open(name=str(path), mode="rb") as traj:
+        assert len(frames) == len(traj)
+        for snap, got in zip(traj, frames):
+            check_snapshot(snap, got)
+
+
+def test_corrupt_file_is_reported(writer, sample, tmp_path):
+    """A truncated file: hardbody's reader names the file and the problem."""
+    out, _ = sample
+    data = (out / "trajectory.gsd").read_bytes()
+    path = tmp_path / "truncated.gsd"
+    path.write_bytes(data[:-7])
+    result = subprocess.run([writer, "--dump", str(path)], capture_output=True, text=True)
+    assert result.returncode == 1
+    assert str(path) in result.stderr
+    assert "out of bounds" in result.stderr
