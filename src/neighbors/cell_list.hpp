@@ -101,50 +101,75 @@ class CellList {
     return best;
   }
 
-  // Calls fn(j) for every body j in the 27 cells around body i's cell (including i itself).
+  // True when some axis has a single cell: then the stencil cannot tell periodic images apart
+  // and callers must apply the minimum-image convention themselves.
+  bool needs_minimum_image() const { return nc_[0] == 1 || nc_[1] == 1 || nc_[2] == 1; }
+
+  // Calls fn(j, shift) for every body j in the 27 cells around body i's cell (including i
+  // itself); `shift` is the periodic image offset to add to j's position to place it next to i
+  // (zero along axes with a single cell, see needs_minimum_image()).
   template <class Fn>
-  void for_each_neighbor(std::uint32_t i, Fn&& fn) const {
-    const auto& c = coord_[i];
-    std::array<int, 3> lo, hi;
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = nc_[k] == 1 ? 0 : -1;
-      hi[k] = nc_[k] == 1 ? 0 : 1;
-    }
-    for (int dz = lo[2]; dz <= hi[2]; ++dz) {
-      const int z = wrap(c[2] + dz, 2);
-      for (int dy = lo[1]; dy <= hi[1]; ++dy) {
-        const int y = wrap(c[1] + dy, 1);
-        for (int dx = lo[0]; dx <= hi[0]; ++dx) {
-          const int x = wrap(c[0] + dx, 0);
-          for (std::uint32_t j = head_[index(x, y, z)]; j != kNone; j = next_[j]) fn(j);
-        }
-      }
-    }
+  void for_each_neighbor(std::uint32_t i, const Vec3& L, Fn&& fn) const {
+    std::array<int, 3> lo{-1, -1, -1}, hi{1, 1, 1};
+    for (int m = 0; m < 3; ++m)
+      if (nc_[m] == 1) lo[m] = hi[m] = 0;
+    visit(coord_[i], lo, hi, L, fn);
   }
-  // Calls fn(j) for the bodies in the 9 cells that became adjacent to body i when it entered
-  // its cell through face `face` (the far layer of the new 27-cell stencil).
+  // Calls fn(j, shift) for the bodies in the 9 cells that became adjacent to body i when it
+  // entered its cell through face `face` (the far layer of the new 27-cell stencil).
   template <class Fn>
-  void for_each_new_neighbor(std::uint32_t i, int face, Fn&& fn) const {
+  void for_each_new_neighbor(std::uint32_t i, int face, const Vec3& L, Fn&& fn) const {
     const int k = face >> 1;
     if (nc_[k] == 1) return;
-    const auto& c = coord_[i];
     std::array<int, 3> lo{-1, -1, -1}, hi{1, 1, 1};
     for (int m = 0; m < 3; ++m)
       if (nc_[m] == 1) lo[m] = hi[m] = 0;
     lo[k] = hi[k] = (face & 1) ? 1 : -1;
-    for (int dz = lo[2]; dz <= hi[2]; ++dz) {
-      const int z = wrap(c[2] + dz, 2);
-      for (int dy = lo[1]; dy <= hi[1]; ++dy) {
-        const int y = wrap(c[1] + dy, 1);
-        for (int dx = lo[0]; dx <= hi[0]; ++dx) {
-          const int x = wrap(c[0] + dx, 0);
-          for (std::uint32_t j = head_[index(x, y, z)]; j != kNone; j = next_[j]) fn(j);
-        }
-      }
-    }
+    visit(coord_[i], lo, hi, L, fn);
+  }
+  // Without image shifts (tests, diagnostics).
+  template <class Fn>
+  void for_each_neighbor(std::uint32_t i, Fn&& fn) const {
+    for_each_neighbor(i, Vec3::Zero(), [&](std::uint32_t j, const Vec3&) { fn(j); });
+  }
+  template <class Fn>
+  void for_each_new_neighbor(std::uint32_t i, int face, Fn&& fn) const {
+    for_each_new_neighbor(i, face, Vec3::Zero(), [&](std::uint32_t j, const Vec3&) { fn(j); });
   }
 
  private:
+  // Visit the cells c + d for d in [lo, hi] (per axis), wrapping periodically and telling fn
+  // the image shift of each cell.
+  template <class Fn>
+  void visit(const std::array<int, 3>& c, const std::array<int, 3>& lo,
+             const std::array<int, 3>& hi, const Vec3& L, Fn& fn) const {
+    int xs[3], ys[3], zs[3];
+    double sx[3], sy[3], sz[3];
+    const int nx = axis(c[0], lo[0], hi[0], 0, L[0], xs, sx);
+    const int ny = axis(c[1], lo[1], hi[1], 1, L[1], ys, sy);
+    const int nz = axis(c[2], lo[2], hi[2], 2, L[2], zs, sz);
+    for (int a = 0; a < nz; ++a)
+      for (int b = 0; b < ny; ++b) {
+        const std::uint32_t row = static_cast<std::uint32_t>((zs[a] * nc_[1] + ys[b]) * nc_[0]);
+        for (int d = 0; d < nx; ++d) {
+          const Vec3 shift(sx[d], sy[b], sz[a]);
+          for (std::uint32_t j = head_[row + xs[d]]; j != kNone; j = next_[j]) fn(j, shift);
+        }
+      }
+  }
+  int axis(int c, int lo, int hi, int k, double L, int* out, double* shift) const {
+    int n = 0;
+    for (int d = lo; d <= hi; ++d, ++n) {
+      int x = c + d;
+      double s = 0.0;
+      if (x < 0) x += nc_[k], s = -L;
+      else if (x >= nc_[k]) x -= nc_[k], s = L;
+      out[n] = x;
+      shift[n] = s;
+    }
+    return n;
+  }
+
   void place(std::uint32_t i, const std::array<int, 3>& c) {
     const std::uint32_t id = index(c[0], c[1], c[2]);
     coord_[i] = c;

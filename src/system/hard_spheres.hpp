@@ -23,16 +23,29 @@ struct HardSpheres {
   // Batch form used by the event loop: branch-free over the candidate list, so the CPU does not
   // mispredict on which pairs approach (about half of them).
   void contact_times(const State& s, const Box& box, std::uint32_t i, const std::uint32_t* js,
-                     std::size_t n, double now, double* out) const {
-    const Vec3 ri = s.r[i], vi = s.v[i];
+                     const Vec3* shifts, std::size_t n, bool min_image, double now,
+                     double* out) const {
+    const double* R = s.r.data()->data();
+    const double* V = s.v.data()->data();
+    const double* T = s.t.data();
+    const double xi = R[3 * i], yi = R[3 * i + 1], zi = R[3 * i + 2];
+    const double ui = V[3 * i], vi = V[3 * i + 1], wi = V[3 * i + 2];
     const double s2 = sigma * sigma;
     for (std::size_t k = 0; k < n; ++k) {
       const std::uint32_t j = js[k];
-      const Vec3 dr = box.near_image(s.r[j] + s.v[j] * (now - s.t[j]) - ri);
-      const Vec3 dv = s.v[j] - vi;
-      const double b = dr.dot(dv);
-      const double c = dr.squaredNorm() - s2;
-      const double disc = b * b - dv.squaredNorm() * c;
+      const double dt = now - T[j];
+      const double du = V[3 * j] - ui, dv = V[3 * j + 1] - vi, dw = V[3 * j + 2] - wi;
+      double dx = R[3 * j] + V[3 * j] * dt + shifts[k].x() - xi;
+      double dy = R[3 * j + 1] + V[3 * j + 1] * dt + shifts[k].y() - yi;
+      double dz = R[3 * j + 2] + V[3 * j + 2] * dt + shifts[k].z() - zi;
+      if (min_image) {
+        const Vec3 d = box.minimum_image(Vec3(dx, dy, dz));
+        dx = d.x(), dy = d.y(), dz = d.z();
+      }
+      const double b = dx * du + dy * dv + dz * dw;
+      const double c = dx * dx + dy * dy + dz * dz - s2;
+      const double a = du * du + dv * dv + dw * dw;
+      const double disc = b * b - a * c;
       const double t = c / (std::sqrt(std::max(disc, 0.0)) - b);
       const double tc = c <= 0.0 ? 0.0 : t;
       out[k] = (b < 0.0 && disc >= 0.0 && j != i) ? tc : kInf;

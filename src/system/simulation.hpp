@@ -1,7 +1,9 @@
 // The event loop: the one place that wires the state, the event calendar, the cell lists and the
 // pair dynamics together. `Model` supplies the physics of a pair:
-//   void contact_times(const State&, const Box&, i, const uint32_t* js, size_t n, double now,
-//                      double* out)                                    // times from now, or +inf
+//   void contact_times(const State&, const Box&, i, const uint32_t* js, const Vec3* shifts,
+//                      size_t n, bool min_image, double now, double* out)
+//       times from now (or +inf) of body i against bodies js placed at their periodic image
+//       r_j + shift (or at the minimum image when min_image is set)
 //   CollisionRecord collide(State&, const Box&, i, j, double now)     // both bodies at `now`
 //   double interaction_range() const                                  // max centre distance at contact
 // Each body owns one slot of the calendar holding its earliest event; a collision event is
@@ -105,7 +107,8 @@ class Simulation {
         if (b.type == EventType::None || state_.count[b.partner] == b.partner_count) {
           Event best = b;
           cand_.clear();
-          cells_.for_each_new_neighbor(i, face, [&](std::uint32_t j) { cand_.push_back(j); });
+          shift_.clear();
+          cells_.for_each_new_neighbor(i, face, box_.L, collect());
           consider(i, best);
           schedule(i, best);
         } else {
@@ -136,7 +139,8 @@ class Simulation {
   void consider(std::uint32_t i, Event& best) {
     const std::size_t n = cand_.size();
     if (times_.size() < n) times_.resize(2 * n);
-    model_.contact_times(state_, box_, i, cand_.data(), n, now_, times_.data());
+    model_.contact_times(state_, box_, i, cand_.data(), shift_.data(), n,
+                         cells_.needs_minimum_image(), now_, times_.data());
     std::size_t kbest = n;
     double tbest = best.time - now_;
     for (std::size_t k = 0; k < n; ++k)
@@ -150,13 +154,20 @@ class Simulation {
       best.type = EventType::Collision;
     }
   }
+  auto collect() {
+    return [this](std::uint32_t j, const Vec3& shift) {
+      cand_.push_back(j);
+      shift_.push_back(shift);
+    };
+  }
   // Full prediction for body i: all bodies in its 27 cells, and its next cell crossing.
   void predict(std::uint32_t i) {
     state_.advance_to(i, now_);
     Event best;
     best.owner = i;
     cand_.clear();
-    cells_.for_each_neighbor(i, [&](std::uint32_t j) { cand_.push_back(j); });
+    shift_.clear();
+    cells_.for_each_neighbor(i, box_.L, collect());
     consider(i, best);
     schedule(i, best);
   }
@@ -184,6 +195,7 @@ class Simulation {
   Queue queue_;
   std::vector<Event> best_;  // each body's best predicted collision (for cell crossings)
   std::vector<std::uint32_t> cand_;  // candidate partners of the body being predicted
+  std::vector<Vec3> shift_;          // their periodic image shifts
   std::vector<double> times_;        // their contact times
   std::array<std::uint64_t, kEventTypes> counts_{};
   std::uint64_t stale_ = 0;
