@@ -243,7 +243,7 @@ std::vector<std::string> Reader::names_with_prefix(std::string_view prefix) cons
 }
 
 const Chunk* Reader::find(std::uint64_t frame, std::string_view name) const {
-  const auto it = ids_.find(std::string(name));
+  const auto it = ids_.find(name);
   if (it == ids_.end()) return nullptr;
   auto c = std::lower_bound(index_.begin(), index_.end(), frame,
                             [](const Chunk& a, std::uint64_t f) { return a.frame < f; });
@@ -418,7 +418,7 @@ void Writer::write_chunk(std::string_view name, Type type, std::uint64_t N, std:
   if (N > 0 && data == nullptr) throw bad("no data");
 
   std::uint16_t id = 0;
-  if (auto it = ids_.find(std::string(name)); it != ids_.end()) {
+  if (auto it = ids_.find(name); it != ids_.end()) {
     id = it->second;
     for (const Chunk& c : pending_)
       if (c.id == id) throw bad(fmt::format("already written in frame {}", frame_));

@@ -22,6 +22,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -94,6 +95,13 @@ struct Array {
 };
 
 namespace detail {
+// Name -> id map that looks up string_views without building a std::string.
+struct NameHash {
+  using is_transparent = void;
+  std::size_t operator()(std::string_view s) const { return std::hash<std::string_view>{}(s); }
+};
+using NameIds = std::unordered_map<std::string, std::uint16_t, NameHash, std::equal_to<>>;
+
 // An owned POSIX file descriptor: closed on destruction, moved by value.
 class Fd {
  public:
@@ -183,7 +191,7 @@ class Reader {
   std::uint64_t namelist_allocated_ = 0;  // 64-byte segments
   std::uint64_t namelist_used_ = 0;       // bytes, including terminators
   std::vector<std::string> names_;
-  std::unordered_map<std::string, std::uint16_t> ids_;
+  detail::NameIds ids_;
   std::vector<Chunk> index_;              // used entries only
   std::uint64_t nframes_ = 0;
 };
@@ -246,7 +254,7 @@ class Writer {
   std::uint64_t namelist_allocated_ = 0;   // 64-byte segments
   std::uint64_t namelist_written_ = 0;     // bytes of names already in the file
   std::vector<std::string> names_;
-  std::unordered_map<std::string, std::uint16_t> ids_;
+  detail::NameIds ids_;
   std::size_t names_committed_ = 0;        // names_[0, names_committed_) are in the file
   std::vector<Chunk> pending_;             // entries of the current frame
   std::vector<std::byte> buffer_;          // chunk data not yet written
