@@ -171,22 +171,23 @@ class Plotter:
         ax.axhline(0.0, color="gray", lw=0.8)
         self.save(fig, "fself.png")
 
-    def gr(self, path: Path) -> None:
+    def simple(self, path: Path, x: str, y: str, name: str, title: str,
+               hline: float | None = None) -> None:
+        """One column against another, e.g. g(r) or S2(t)."""
         _, c = read_table(path)
-        require(c, path, "r", "g")
-        fig, ax = self.figure("r", "g(r)", "radial distribution function")
-        x, y = finite_pairs(c["r"], c["g"])
-        ax.plot(x, y, "-")
-        ax.axhline(1.0, color="gray", lw=0.8)
-        self.save(fig, "gr.png")
+        require(c, path, x, y)
+        fig, ax = self.figure(x, y, title)
+        xs, ys = finite_pairs(c[x], c[y])
+        ax.plot(xs, ys, "-")
+        if hline is not None:
+            ax.axhline(hline, color="gray", lw=0.8)
+        self.save(fig, name)
+
+    def gr(self, path: Path) -> None:
+        self.simple(path, "r", "g", "gr.png", "radial distribution function g(r)", hline=1.0)
 
     def nematic(self, path: Path) -> None:
-        meta, c = read_table(path)
-        require(c, path, "time", "S2")
-        fig, ax = self.figure("time", "S2", "nematic order parameter")
-        x, y = finite_pairs(c["time"], c["S2"])
-        ax.plot(x, y, "-")
-        self.save(fig, "s2.png")
+        self.simple(path, "time", "S2", "s2.png", "nematic order parameter")
 
 
 def main(argv: list[str]) -> int:
