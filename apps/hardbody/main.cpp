@@ -34,6 +34,9 @@ int main(int argc, char** argv) {
   } catch (const hb::InputError& e) {
     std::fprintf(stderr, "hardbody: error: %s\n", e.what());
     return 2;
+  } catch (const hb::RunInterrupted& e) {
+    std::fprintf(stderr, "hardbody: %s\n", e.what());
+    return 128 + e.signal;
   } catch (const hb::RunFailure& e) {
     std::fprintf(stderr, "hardbody: run failed: %s\n", e.what());
     return 3;

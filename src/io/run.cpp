@@ -2,13 +2,19 @@
 
 #include <fmt/format.h>
 
+#include <atomic>
+#include <csignal>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
 
+#include "io/checkpoint.hpp"
 #include "io/config.hpp"
 #include "io/files.hpp"
+#include "io/gsd_hoomd.hpp"
 #include "io/progress.hpp"
 #include "observers/overlap.hpp"
 #include "observers/thermo.hpp"
@@ -18,6 +24,25 @@
 namespace hb {
 
 namespace {
+
+std::atomic<int> g_signal{0};
+extern "C" void on_signal(int sig) { g_signal.store(sig); }
+
+struct SignalGuard {
+  struct sigaction old_int {}, old_term {};
+  SignalGuard() {
+    g_signal.store(0);
+    struct sigaction sa {};
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &old_int);
+    sigaction(SIGTERM, &sa, &old_term);
+  }
+  ~SignalGuard() {
+    sigaction(SIGINT, &old_int, nullptr);
+    sigaction(SIGTERM, &old_term, nullptr);
+  }
+};
 
 double cpu_seconds() {
   timespec ts;
@@ -42,41 +67,55 @@ nlohmann::json shape_json(const ShapeSpec& s) {
 }
 
 // Everything a hard-sphere run needs, checked before any file is written.
-struct SpherePlan {
-  SphereSystemSpec spec;
-  Box box;
-};
-
-SpherePlan plan_spheres(const Config& c) {
-  SpherePlan p;
-  p.spec.n = c.particles;
-  p.spec.phi = c.packing_fraction;
-  p.spec.sigma = 2.0 * c.shape.radius;
-  p.spec.mass = c.mass;
-  p.spec.kT = c.temperature;
-  p.spec.seed = c.seed;
-  const double v = c.shape.volume();
-  p.box = cubic_box_for(c.particles, v, c.packing_fraction);
+SphereSystemSpec plan_spheres(const Config& c) {
+  SphereSystemSpec p;
+  p.n = c.particles;
+  p.phi = c.packing_fraction;
+  p.sigma = 2.0 * c.shape.radius;
+  p.mass = c.mass;
+  p.kT = c.temperature;
+  p.seed = c.seed;
+  p.shell = c.neighbors_method == "nnl" ? c.shell : 0.0;
+  const Box box = cubic_box_for(c.particles, c.shape.volume(), c.packing_fraction);
   const double phi_max = fcc_max_packing_fraction(c.particles);
   if (c.packing_fraction > phi_max * (1.0 - 1e-12))
     throw ConfigError(fmt::format(
         "{}: key 'system.packing_fraction': {} is too dense for an FCC start with {} particles "
         "(at most {:.4f}; use N = 4 m^3 for up to 0.74)",
         c.source, c.packing_fraction, c.particles, phi_max));
-  if (p.box.L.minCoeff() < 2.0 * p.spec.sigma)
+  const double reach = p.sigma + p.shell;
+  if (box.L.minCoeff() < 2.0 * reach)
     throw ConfigError(fmt::format(
         "{}: key 'system.particles': {} particles at packing fraction {} give a box of side "
-        "{:.3g}, less than two diameters; use more particles",
-        c.source, c.particles, c.packing_fraction, p.box.L.x()));
+        "{:.3g}, less than two interaction ranges ({:.3g}); use more particles",
+        c.source, c.particles, c.packing_fraction, box.L.x(), 2.0 * reach));
   return p;
 }
 
+// Rows of log.tsv, kept in log.tsv.part while running and renamed at the end.
 class LogTable {
  public:
-  explicit LogTable(std::string path) : path_(std::move(path)), part_(path_ + ".part") {
-    out_.open(part_);
+  static constexpr const char* kHeader =
+      "time\tcollisions\tZ_block\tZ_mean\ttemperature\tenergy_drift\tcollision_rate\n";
+  // Opens the table keeping the first `keep_rows` data rows of an existing .part file.
+  LogTable(std::string path, std::uint64_t keep_rows, bool resume)
+      : path_(std::move(path)), part_(path_ + ".part") {
+    std::string kept = kHeader;
+    if (resume) {
+      std::ifstream in(part_);
+      if (!in && keep_rows > 0)
+        throw InputError(fmt::format("{}: missing; it holds the log rows before the checkpoint", part_));
+      std::string line;
+      std::getline(in, line);  // header
+      for (std::uint64_t k = 0; k < keep_rows; ++k) {
+        if (!std::getline(in, line))
+          throw InputError(fmt::format("{}: has fewer rows than the checkpoint records", part_));
+        kept += line + "\n";
+      }
+    }
+    write_file_atomic(part_, kept);
+    out_.open(part_, std::ios::app);
     if (!out_) throw InputError(fmt::format("{}: cannot write", part_));
-    out_ << "time\tcollisions\tZ_block\tZ_mean\ttemperature\tenergy_drift\tcollision_rate\n";
   }
   template <class... T>
   void row(const T&... v) {
@@ -96,143 +135,299 @@ class LogTable {
   std::ofstream out_;
 };
 
+// Keeps the first `frames` frames of a trajectory (after a resume from an older checkpoint).
+void truncate_trajectory(const std::string& path, std::uint64_t frames) {
+  const gsd::Reader r(path);
+  if (r.nframes() == frames) return;
+  if (r.nframes() < frames)
+    throw InputError(fmt::format("{}: has {} frames, the checkpoint expects at least {}", path,
+                                 r.nframes(), frames));
+  const std::string tmp = path + ".trunc";
+  {
+    auto w = gsd::HoomdWriter::create(tmp);
+    for (std::uint64_t f = 0; f < frames; ++f) w.write_frame(gsd::read_frame(r, f));
+    w.sync();
+    w.close();
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+class Interrupted : public std::runtime_error {
+ public:
+  explicit Interrupted(int sig) : std::runtime_error("interrupted"), signal(sig) {}
+  int signal;
+};
+
+// The run driver, generic over the simulation type (sphere cells / sphere lists / ...).
+template <class Sim>
+class Driver {
+ public:
+  Driver(const Config& cfg, const RunOptions& opt, const std::string& dir, Sim& sim,
+         const DriverState& st, const ShapeSpec& shape, double sigma)
+      : cfg_(cfg), opt_(opt), dir_(dir), sim_(sim), st_(st), shape_(shape), sigma_(sigma) {}
+
+  void run() {
+    const double t_eq = cfg_.equilibrate_time, t_end = t_eq + cfg_.time;
+    const std::uint64_t n = sim_.state().size();
+    LogTable log(dir_ + "/log.tsv", st_.log_rows, opt_.resume);
+    const std::string traj = dir_ + "/trajectory.gsd";
+    std::optional<gsd::HoomdWriter> writer;
+    if (cfg_.trajectory) {
+      if (opt_.resume && st_.frames > 0) {
+        truncate_trajectory(traj, st_.frames);
+        writer.emplace(gsd::HoomdWriter::append(traj));
+      } else {
+        writer.emplace(gsd::HoomdWriter::create(traj));
+      }
+    }
+    const double cpu0 = cpu_seconds();
+    last_checkpoint_ = progress_.wall_seconds();
+    auto measured_cpu = [&] { return st_.cpu_prev + (st_.phase == 1 ? cpu_seconds() - cpu_mark_ : 0.0); };
+    if (st_.phase == 1) cpu_mark_ = cpu0;
+
+    std::uint64_t steps = 0;
+    while (st_.phase < 2) {
+      if (st_.phase == 0 && sim_.now() >= t_eq) {
+        // start of the measured run
+        st_.phase = 1;
+        st_.e0 = energy();
+        st_.coll0 = double(sim_.collisions());
+        st_.stale0 = double(sim_.stale_events());
+        for (int k = 0; k < kEventTypes; ++k) st_.events0[k] = double(sim_.event_counts()[k]);
+        st_.block_start = sim_.now();
+        st_.next_snapshot = sim_.now();
+        cpu_mark_ = cpu_seconds();
+        wall_mark_ = progress_.wall_seconds();
+      }
+      if (st_.phase == 1 && writer && sim_.now() >= st_.next_snapshot) {
+        writer->write_frame(make_frame(sim_, shape_, false, nullptr));
+        writer->sync();
+        st_.frames += 1;
+        st_.next_snapshot += cfg_.snapshot_interval;
+      }
+      const double block_end = st_.phase == 0 ? t_eq : std::min(t_end, st_.block_start + cfg_.log_interval);
+      double target = block_end;
+      if (st_.phase == 1 && writer) target = std::min(target, st_.next_snapshot);
+      bool limit = false;
+      for (;;) {
+        const StepInfo s = sim_.step(target);
+        if (s.type == EventType::None) break;
+        if (st_.phase == 1 && s.type == EventType::Collision && !s.stale) {
+          pressure_.on_collision(s.record);
+          if (cfg_.max_collisions &&
+              sim_.collisions() - std::uint64_t(st_.coll0) >= cfg_.max_collisions) {
+            limit = true;
+            break;
+          }
+        }
+        if ((++steps & 4095) == 0) housekeeping();
+      }
+      if (st_.phase == 1 && (sim_.now() >= block_end || limit)) {
+        const double kT = temperature();
+        pressure_.close_block(sim_.now() - st_.block_start, kT, n);
+        st_.block_start = sim_.now();
+        log.row(sim_.now() - t_eq, double(sim_.collisions()) - st_.coll0, pressure_.last_Z(),
+                pressure_.Z().mean, kT, (energy() - st_.e0) / st_.e0,
+                pressure_.collision_rate().mean);
+        st_.log_rows += 1;
+        if (sim_.now() >= t_end || limit) {
+          st_.phase = 2;
+          st_.cpu_prev = measured_cpu();
+          st_.wall_prev += progress_.wall_seconds() - wall_mark_;
+          wall_mark_ = progress_.wall_seconds();
+        }
+      }
+      housekeeping();
+      const double frac = st_.phase == 0 ? sim_.now() / t_end
+                                         : std::max(sim_.now() / t_end,
+                                                    cfg_.max_collisions ? (double(sim_.collisions()) - st_.coll0) / cfg_.max_collisions : 0.0);
+      if (!opt_.quiet)
+        progress_.update(st_.phase == 0 ? "equilibrate" : "measure", sim_.now(), sim_.collisions(),
+                         st_.phase == 0 ? 0.0 : pressure_.Z().mean, std::min(frac, 1.0));
+    }
+    if (!opt_.quiet) progress_.finish();
+    write_checkpoint();
+    if (writer) writer->close();
+    finish(log);
+  }
+
+  // Checkpoint of the current moment (also used on failures).
+  void write_checkpoint() {
+    st_.pressure = pressure_.save();
+    if (st_.phase == 1) {
+      const double c = cpu_seconds(), w = progress_.wall_seconds();
+      st_.cpu_prev += c - cpu_mark_;
+      st_.wall_prev += w - wall_mark_;
+      cpu_mark_ = c;
+      wall_mark_ = w;
+    }
+    gsd::write_frame_atomic(dir_ + "/checkpoint.gsd", make_checkpoint(sim_, shape_, cfg_, st_));
+    last_checkpoint_ = progress_.wall_seconds();
+  }
+
+  void restore_pressure(const std::vector<double>& p) {
+    if (!p.empty()) pressure_.load(p);
+  }
+
+ private:
+  void housekeeping() {
+    if (const int sig = g_signal.load()) throw Interrupted(sig);
+    if (progress_.wall_seconds() - last_checkpoint_ >= cfg_.checkpoint_interval) write_checkpoint();
+  }
+  double energy() const { return kinetic_energy(sim_.state(), cfg_.mass); }
+  double temperature() const {
+    return 2.0 * energy() / (3.0 * double(sim_.state().size()));
+  }
+
+  void finish(LogTable& log) {
+    const State st = synchronized_state(sim_);
+    const std::uint64_t n = st.size();
+    const double e1 = kinetic_energy(st, cfg_.mass);
+    const Vec3 p = total_momentum(st, cfg_.mass);
+    double p_scale = 0.0;
+    for (const auto& v : st.v) p_scale += cfg_.mass * v.norm();
+    const auto rep = sphere_overlaps(st.r, sim_.box(), sigma_);
+    const std::uint64_t ncoll = sim_.collisions() - std::uint64_t(st_.coll0);
+    const auto Z = pressure_.Z();
+    const auto rate = pressure_.collision_rate();
+    const double cpu = st_.cpu_prev, wall = st_.wall_prev;
+
+    nlohmann::json j;
+    j["particles"] = n;
+    j["packing_fraction"] = double(n) * cfg_.shape.volume() / sim_.box().volume();
+    j["box"] = {sim_.box().L.x(), sim_.box().L.y(), sim_.box().L.z()};
+    j["shape"] = shape_json(cfg_.shape);
+    j["time"] = pressure_.measured_time();
+    j["collisions"] = ncoll;
+    j["wall_seconds"] = wall;
+    j["cpu_seconds"] = cpu;
+    j["collisions_per_second"] = cpu > 0 ? double(ncoll) / cpu : 0.0;
+    j["tau_c_us"] = ncoll > 0 ? 1e6 * cpu / double(ncoll) : 0.0;
+    j["Z"] = Z.mean;
+    j["Z_error"] = Z.error;
+    j["Z_blocks"] = Z.blocks;
+    j["collision_rate"] = rate.mean;
+    j["collision_rate_error"] = rate.error;
+    j["temperature"] = 2.0 * e1 / (3.0 * double(n));
+    j["energy_drift"] = (e1 - st_.e0) / st_.e0;
+    j["total_momentum"] = {p.x(), p.y(), p.z()};
+    j["momentum_drift"] = p.norm() / p_scale;
+    j["overlaps"] = rep.overlaps;
+    j["min_distance"] = rep.min_distance;
+    nlohmann::json ev;
+    const auto& events = sim_.event_counts();
+    for (int k = 1; k < kEventTypes; ++k)
+      if (events[k] > 0 || k == int(EventType::Collision))
+        ev[event_name(EventType(k))] = double(events[k]) - st_.events0[k];
+    ev["stale"] = double(sim_.stale_events()) - st_.stale0;
+    j["events"] = ev;
+    j["solver_fallbacks"] = 0;
+    j["seed"] = cfg_.seed;
+    j["neighbors"] = cfg_.neighbors_method;
+    j["equilibrate_time"] = cfg_.equilibrate_time;
+    j["trajectory_frames"] = st_.frames;
+    log.commit();
+    write_file_atomic(dir_ + "/summary.json", j.dump(2) + "\n");
+    if (!opt_.quiet)
+      std::fprintf(stderr, "hardbody: %s: t=%.6g collisions=%llu Z=%.5f +- %.5f overlaps=%llu -> %s\n",
+                   cfg_.source.c_str(), pressure_.measured_time(), (unsigned long long)ncoll, Z.mean,
+                   Z.error, (unsigned long long)rep.overlaps, dir_.c_str());
+    if (rep.overlaps > 0)
+      throw RunFailure(fmt::format("{} overlapping pairs in the final state (min gap {:.3g})",
+                                   rep.overlaps, rep.min_distance));
+  }
+
+  const Config& cfg_;
+  const RunOptions& opt_;
+  std::string dir_;
+  Sim& sim_;
+  DriverState st_;
+  ShapeSpec shape_;
+  double sigma_;
+  VirialPressure pressure_;
+  Progress progress_;
+  double cpu_mark_ = 0.0, wall_mark_ = 0.0, last_checkpoint_ = 0.0;
+};
+
+template <class Sim>
+void drive(const Config& cfg, const RunOptions& opt, const std::string& dir, Sim& sim,
+           const DriverState& st, double sigma) {
+  Driver<Sim> d(cfg, opt, dir, sim, st, cfg.shape, sigma);
+  d.restore_pressure(st.pressure);
+  try {
+    d.run();
+  } catch (const Interrupted& e) {
+    d.write_checkpoint();
+    throw RunInterrupted(fmt::format(
+        "interrupted by signal {}; checkpoint written to {}/checkpoint.gsd (continue with --resume)",
+        e.signal, dir), e.signal);
+  } catch (const ConfigError&) {
+    throw;
+  } catch (const InputError&) {
+    throw;
+  } catch (const RunFailure& e) {
+    try {
+      d.write_checkpoint();
+    } catch (...) {
+    }
+    throw;
+  } catch (const std::exception& e) {
+    try {
+      d.write_checkpoint();
+    } catch (...) {
+    }
+    throw RunFailure(fmt::format("{} (checkpoint written to {}/checkpoint.gsd)", e.what(), dir));
+  }
+}
+
+template <class Sim>
+void start_or_resume(const Config& cfg, const RunOptions& opt, const std::string& dir,
+                     const SphereSystemSpec& spec, Sim (*make)(const SphereSystemSpec&),
+                     typename Sim::neighbors_type nb) {
+  const SignalGuard guard;
+  if (opt.resume) {
+    const std::string ck = dir + "/checkpoint.gsd";
+    if (!file_exists(ck)) throw InputError(fmt::format("{}: no checkpoint to resume from", ck));
+    auto r = read_checkpoint<typename Sim::neighbors_type>(ck, cfg);
+    nb.restore(r.box, r.state, r.neighbors);
+    Sim sim(r.box, std::move(r.state), HardSpheres{spec.sigma, spec.mass}, std::move(nb), r.loop);
+    drive(cfg, opt, dir, sim, r.driver, spec.sigma);
+    return;
+  }
+  Sim sim = make(spec);
+  {
+    const auto rep = sphere_overlaps(sim.state().r, sim.box(), spec.sigma);
+    if (rep.overlaps > 0)
+      throw InputError(fmt::format("{}: the initial configuration has {} overlapping pairs",
+                                   cfg.source, rep.overlaps));
+  }
+  make_directories(dir);
+  write_file_atomic(dir + "/config.resolved.toml", to_toml(cfg));
+  drive(cfg, opt, dir, sim, DriverState{}, spec.sigma);
+}
+
 }  // namespace
 
 void run_simulation(const RunOptions& opt) {
-  Config cfg = load_config(opt.config_path, opt.overrides);
-  if (opt.resume) throw InputError("--resume: checkpoint restart is not implemented yet");
+  const Config cfg = load_config(opt.config_path, opt.overrides);
   if (cfg.shape.type != "sphere")
     throw InputError(fmt::format(
         "{}: key 'shape.type': '{}' bodies are not yet supported by `hardbody run` (only "
         "spheres; `hardbody distance` and `contact-time` take any shape)",
         cfg.source, cfg.shape.type));
-  if (cfg.neighbors_method == "nnl")
-    cfg.neighbors_method = "cells";  // spheres: cell lists are the neighbour method
-  const SpherePlan plan = plan_spheres(cfg);
-
-  // Build the system before writing anything: a bad start fails with nothing on disk.
-  auto sim = make_hard_sphere_simulation(plan.spec);
-  {
-    const auto rep = sphere_overlaps(sim.state().r, sim.box(), plan.spec.sigma);
-    if (rep.overlaps > 0)
-      throw InputError(fmt::format("{}: the initial configuration has {} overlapping pairs",
-                                   cfg.source, rep.overlaps));
-  }
+  // Everything is checked before any file is written.
+  const SphereSystemSpec spec = plan_spheres(cfg);
   const std::string dir = opt.out_dir.empty() ? default_out_dir(opt.config_path) : opt.out_dir;
   try {
-    make_directories(dir);
-    write_file_atomic(dir + "/config.resolved.toml", to_toml(cfg));
-  } catch (const std::runtime_error& e) {
+    if (spec.shell > 0.0)
+      start_or_resume<SphereListSim>(cfg, opt, dir, spec, &make_hard_sphere_list_simulation,
+                                     ShellNeighbors(spec.sigma, spec.shell));
+    else
+      start_or_resume<SphereCellSim>(cfg, opt, dir, spec, &make_hard_sphere_cell_simulation,
+                                     CellNeighbors(spec.sigma));
+  } catch (const std::filesystem::filesystem_error& e) {
     throw InputError(e.what());
   }
-
-  const std::size_t n = cfg.particles;
-  const double mass = cfg.mass;
-  const double t_eq = cfg.equilibrate_time, t_end = cfg.equilibrate_time + cfg.time;
-  Progress progress;
-  const double cpu0 = cpu_seconds();
-  VirialPressure pressure;
-  auto kT_now = [&](const State& s) { return 2.0 * kinetic_energy(s, mass) / (3.0 * double(n)); };
-
-  // Equilibration: same dynamics, nothing measured.
-  while (sim.now() < t_eq) {
-    const double target = std::min(t_eq, sim.now() + cfg.log_interval);
-    while (sim.step(target).type != EventType::None) {
-    }
-    progress.update("equilibrate", sim.now(), sim.collisions(), 0.0, sim.now() / t_end);
-  }
-
-  // Measurement.
-  LogTable log(dir + "/log.tsv");
-  const double e0 = kinetic_energy(sim.state(), mass);
-  const std::uint64_t coll0 = sim.collisions();
-  const auto events0 = sim.event_counts();
-  const std::uint64_t stale0 = sim.stale_events();
-  const double cpu_m0 = cpu_seconds(), wall_m0 = progress.wall_seconds();
-  bool limit_hit = false;
-  while (sim.now() < t_end && !limit_hit) {
-    const double t0 = sim.now();
-    const double target = std::min(t_end, t0 + cfg.log_interval);
-    for (;;) {
-      const StepInfo s = sim.step(target);
-      if (s.type == EventType::None) break;
-      if (s.type == EventType::Collision && !s.stale) {
-        pressure.on_collision(s.record);
-        if (cfg.max_collisions && sim.collisions() - coll0 >= cfg.max_collisions) {
-          limit_hit = true;
-          break;
-        }
-      }
-    }
-    const double kT = kT_now(sim.state());
-    pressure.close_block(sim.now() - t0, kT, n);
-    const double e = kinetic_energy(sim.state(), mass);
-    log.row(sim.now() - t_eq, double(sim.collisions() - coll0), pressure.last_Z(), pressure.Z().mean,
-            kT, (e - e0) / e0, pressure.collision_rate().mean);
-    progress.update("measure", sim.now(), sim.collisions(), pressure.Z().mean,
-                    std::max((sim.now()) / t_end,
-                             cfg.max_collisions ? double(sim.collisions() - coll0) / cfg.max_collisions : 0.0));
-  }
-  progress.finish();
-  const double cpu = cpu_seconds() - cpu_m0, wall = progress.wall_seconds() - wall_m0;
-
-  sim.synchronize();
-  const State& st = sim.state();
-  const double e1 = kinetic_energy(st, mass);
-  const Vec3 p = total_momentum(st, mass);
-  double p_scale = 0.0;
-  for (const auto& v : st.v) p_scale += mass * v.norm();
-  const auto rep = sphere_overlaps(st.r, sim.box(), plan.spec.sigma);
-  const std::uint64_t ncoll = sim.collisions() - coll0;
-  const auto Z = pressure.Z();
-  const auto rate = pressure.collision_rate();
-
-  nlohmann::json j;
-  j["particles"] = n;
-  j["packing_fraction"] = double(n) * cfg.shape.volume() / sim.box().volume();
-  j["box"] = {sim.box().L.x(), sim.box().L.y(), sim.box().L.z()};
-  j["shape"] = shape_json(cfg.shape);
-  j["time"] = pressure.measured_time();
-  j["collisions"] = ncoll;
-  j["wall_seconds"] = wall;
-  j["cpu_seconds"] = cpu;
-  j["collisions_per_second"] = cpu > 0 ? double(ncoll) / cpu : 0.0;
-  j["tau_c_us"] = ncoll > 0 ? 1e6 * cpu / double(ncoll) : 0.0;
-  j["Z"] = Z.mean;
-  j["Z_error"] = Z.error;
-  j["Z_blocks"] = Z.blocks;
-  j["collision_rate"] = rate.mean;
-  j["collision_rate_error"] = rate.error;
-  j["temperature"] = kT_now(st);
-  j["energy_drift"] = (e1 - e0) / e0;
-  j["total_momentum"] = {p.x(), p.y(), p.z()};
-  j["momentum_drift"] = p.norm() / p_scale;
-  j["overlaps"] = rep.overlaps;
-  j["min_distance"] = rep.min_distance;
-  nlohmann::json ev;
-  const auto& events = sim.event_counts();
-  for (int k = 1; k < kEventTypes; ++k)
-    if (k == int(EventType::Collision) || k == int(EventType::CellCross))
-      ev[event_name(EventType(k))] = events[k] - events0[k];
-  ev["stale"] = sim.stale_events() - stale0;
-  j["events"] = ev;
-  j["solver_fallbacks"] = 0;
-  j["seed"] = cfg.seed;
-  j["equilibrate_time"] = t_eq;
-  j["total_cpu_seconds"] = cpu_seconds() - cpu0;
-  try {
-    log.commit();
-    write_file_atomic(dir + "/summary.json", j.dump(2) + "\n");
-  } catch (const std::exception& e) {
-    throw RunFailure(e.what());
-  }
-  if (!opt.quiet)
-    std::fprintf(stderr, "hardbody: %s: t=%.6g collisions=%llu Z=%.5f +- %.5f overlaps=%llu -> %s\n",
-                 cfg.source.c_str(), pressure.measured_time(), (unsigned long long)ncoll, Z.mean,
-                 Z.error, (unsigned long long)rep.overlaps, dir.c_str());
-  if (rep.overlaps > 0)
-    throw RunFailure(fmt::format("{} overlapping pairs in the final state (min gap {:.3g})",
-                                 rep.overlaps, rep.min_distance));
 }
 
 }  // namespace hb

@@ -25,6 +25,13 @@ class RunFailure : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Stopped by SIGINT/SIGTERM after writing a checkpoint: exit status 128 + signal.
+class RunInterrupted : public std::runtime_error {
+ public:
+  RunInterrupted(const std::string& what, int sig) : std::runtime_error(what), signal(sig) {}
+  int signal;
+};
+
 // Runs the simulation; throws ConfigError / InputError / RunFailure.
 void run_simulation(const RunOptions& opt);
 

@@ -57,6 +57,13 @@ class CellList {
     }
     place(i, c);
   }
+  // Insert body i into the cell with the given coordinates.
+  void place_at(std::uint32_t i, const std::array<int, 3>& c) {
+    for (int k = 0; k < 3; ++k)
+      if (c[k] < 0 || c[k] >= nc_[k]) throw std::invalid_argument("cell coordinate out of range");
+    place(i, c);
+  }
+  std::size_t size() const { return cell_.size(); }
   void remove(std::uint32_t i) {
     const std::uint32_t c = cell_[i];
     if (c == kNone) return;

@@ -1,6 +1,7 @@
 // Read-only observers fed by collision records and by the state at log times.
 #pragma once
 #include <cstdint>
+#include <stdexcept>
 #include <vector>
 
 #include "collision/record.hpp"
@@ -55,6 +56,25 @@ class VirialPressure {
     return m;
   }
   double measured_time() const { return total_time_; }
+
+  // Flat serialisation for checkpoints (exact doubles; counts < 2^53).
+  std::vector<double> save() const {
+    std::vector<double> d{sum_, total_sum_, total_time_, total_kT_time_, double(collisions_),
+                          double(total_collisions_), double(n_), last_, double(z_.size())};
+    d.insert(d.end(), z_.begin(), z_.end());
+    d.insert(d.end(), rate_.begin(), rate_.end());
+    return d;
+  }
+  void load(const std::vector<double>& d) {
+    if (d.size() < 9 || d.size() != 9 + 2 * std::size_t(d[8]))
+      throw std::invalid_argument("pressure accumulator record has the wrong length");
+    sum_ = d[0], total_sum_ = d[1], total_time_ = d[2], total_kT_time_ = d[3];
+    collisions_ = std::uint64_t(d[4]), total_collisions_ = std::uint64_t(d[5]);
+    n_ = std::size_t(d[6]), last_ = d[7];
+    const std::size_t nb = std::size_t(d[8]);
+    z_.assign(d.begin() + 9, d.begin() + 9 + nb);
+    rate_.assign(d.begin() + 9 + nb, d.end());
+  }
 
  private:
   double sum_ = 0.0, total_sum_ = 0.0, total_time_ = 0.0, total_kT_time_ = 0.0;

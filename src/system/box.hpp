@@ -16,12 +16,12 @@ struct Box {
     for (int k = 0; k < 3; ++k) d[k] -= L[k] * std::nearbyint(d[k] / L[k]);
     return d;
   }
-  // Minimum image for |d_k| < 1.5 L_k (centres of bodies stored inside or near the box):
-  // one compare per axis, no division. This is the hot path of pair prediction.
+  // Minimum image by repeated subtraction: exact for any d, and one compare per axis in the
+  // usual case of centres stored inside or near the box (no division). Hot path of prediction.
   Vec3 near_image(Vec3 d) const {
     for (int k = 0; k < 3; ++k) {
-      if (d[k] > 0.5 * L[k]) d[k] -= L[k];
-      else if (d[k] < -0.5 * L[k]) d[k] += L[k];
+      while (d[k] > 0.5 * L[k]) d[k] -= L[k];
+      while (d[k] < -0.5 * L[k]) d[k] += L[k];
     }
     return d;
   }

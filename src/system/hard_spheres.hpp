@@ -23,8 +23,7 @@ struct HardSpheres {
   // Batch form used by the event loop: branch-free over the candidate list, so the CPU does not
   // mispredict on which pairs approach (about half of them).
   void contact_times(const State& s, const Box& box, std::uint32_t i, const std::uint32_t* js,
-                     const Vec3* shifts, std::size_t n, bool min_image, double now,
-                     double* out) const {
+                     const Vec3* shifts, std::size_t n, double now, double* out) const {
     const double* R = s.r.data()->data();
     const double* V = s.v.data()->data();
     const double* T = s.t.data();
@@ -35,11 +34,13 @@ struct HardSpheres {
       const std::uint32_t j = js[k];
       const double dt = now - T[j];
       const double du = V[3 * j] - ui, dv = V[3 * j + 1] - vi, dw = V[3 * j + 2] - wi;
-      double dx = R[3 * j] + V[3 * j] * dt + shifts[k].x() - xi;
-      double dy = R[3 * j + 1] + V[3 * j + 1] * dt + shifts[k].y() - yi;
-      double dz = R[3 * j + 2] + V[3 * j + 2] * dt + shifts[k].z() - zi;
-      if (min_image) {
-        const Vec3 d = box.minimum_image(Vec3(dx, dy, dz));
+      double dx = R[3 * j] + V[3 * j] * dt - xi;
+      double dy = R[3 * j + 1] + V[3 * j + 1] * dt - yi;
+      double dz = R[3 * j + 2] + V[3 * j + 2] * dt - zi;
+      if (shifts) {
+        dx += shifts[k].x(), dy += shifts[k].y(), dz += shifts[k].z();
+      } else {
+        const Vec3 d = box.near_image(Vec3(dx, dy, dz));
         dx = d.x(), dy = d.y(), dz = d.z();
       }
       const double b = dx * du + dy * dv + dz * dw;

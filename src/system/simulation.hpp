@@ -1,11 +1,16 @@
-// The event loop: the one place that wires the state, the event calendar, the cell lists and the
-// pair dynamics together. `Model` supplies the physics of a pair:
+// The event loop: the one place that wires the state, the event calendar, the neighbour
+// method and the pair dynamics together.
+//
+// `Model` supplies the physics of a pair:
 //   void contact_times(const State&, const Box&, i, const uint32_t* js, const Vec3* shifts,
-//                      size_t n, bool min_image, double now, double* out)
-//       times from now (or +inf) of body i against bodies js placed at their periodic image
-//       r_j + shift (or at the minimum image when min_image is set)
+//                      size_t n, double now, double* out)
+//       times from now (or +inf) of body i against bodies js; body j is placed at r_j + shift
+//       when shifts is non-null, else at its minimum image (Box::near_image)
 //   CollisionRecord collide(State&, const Box&, i, j, double now)     // both bodies at `now`
 //   double interaction_range() const                                  // max centre distance at contact
+// `Neighbors` (CellNeighbors, ShellNeighbors) supplies the candidates of a body and its own
+// event (cell crossing, list rebuild); see neighbors/.
+//
 // Each body owns one slot of the calendar holding its earliest event; a collision event is
 // checked against the partner's counter when it comes up (lazy invalidation).
 #pragma once
@@ -18,11 +23,21 @@
 #include "collision/record.hpp"
 #include "events/event.hpp"
 #include "events/queue.hpp"
-#include "neighbors/cell_list.hpp"
 #include "system/box.hpp"
 #include "system/state.hpp"
 
 namespace hb {
+
+// Everything beyond the State that the event loop needs to continue exactly where it was:
+// the calendar (each body's slot) and each body's remembered best collision. Together with the
+// State (positions at their own time stamps, counters) and the neighbour structure's own
+// snapshot, restoring it continues the run bit for bit.
+struct LoopSnapshot {
+  double now = 0.0;
+  std::vector<Event> slot, best;
+  std::array<std::uint64_t, kEventTypes> counts{};
+  std::uint64_t stale = 0;
+};
 
 struct StepInfo {
   EventType type = EventType::None;  // None: the time limit was reached
@@ -30,22 +45,43 @@ struct StepInfo {
   CollisionRecord record;            // filled for real collisions
 };
 
-template <class Model, class Queue = IndexedHeap>
+template <class Model, class Neighbors, class Queue = IndexedHeap>
 class Simulation {
  public:
-  Simulation(const Box& box, State state, Model model, double now = 0.0)
-      : box_(box), state_(std::move(state)), model_(std::move(model)), now_(now) {
+  using neighbors_type = Neighbors;
+  using model_type = Model;
+
+  Simulation(const Box& box, State state, Model model, Neighbors neighbors, double now = 0.0)
+      : box_(box), state_(std::move(state)), model_(std::move(model)),
+        nb_(std::move(neighbors)), now_(now) {
     const std::size_t n = state_.size();
     if (n == 0) throw std::invalid_argument("no particles");
-    cells_.init(box_.L, model_.interaction_range(), n);
+    nb_.init(box_, state_, now_);
     queue_.reset(static_cast<std::uint32_t>(n));
     best_.assign(n, Event{});
-    for (std::uint32_t i = 0; i < n; ++i) {
-      state_.advance_to(i, now_);
-      state_.image[i] += box_.wrap(state_.r[i]);
-      cells_.insert(i, state_.r[i]);
-    }
     for (std::uint32_t i = 0; i < n; ++i) predict(i);
+  }
+
+  // Continue from a snapshot (no re-prediction, no streaming: bit-for-bit continuation).
+  // `neighbors` must have been restored to the same moment (see the neighbour classes).
+  Simulation(const Box& box, State state, Model model, Neighbors neighbors, const LoopSnapshot& snap)
+      : box_(box), state_(std::move(state)), model_(std::move(model)), nb_(std::move(neighbors)),
+        now_(snap.now), best_(snap.best), counts_(snap.counts), stale_(snap.stale) {
+    const std::size_t n = state_.size();
+    if (snap.slot.size() != n || snap.best.size() != n)
+      throw std::invalid_argument("snapshot does not match the number of bodies");
+    queue_.reset(static_cast<std::uint32_t>(n));
+    for (const Event& e : snap.slot) queue_.set(e);
+  }
+  LoopSnapshot snapshot() const {
+    LoopSnapshot s;
+    s.now = now_;
+    s.slot.resize(state_.size());
+    for (std::uint32_t i = 0; i < state_.size(); ++i) s.slot[i] = queue_.event_of(i);
+    s.best = best_;
+    s.counts = counts_;
+    s.stale = stale_;
+    return s;
   }
 
   double now() const { return now_; }
@@ -53,7 +89,7 @@ class Simulation {
   const State& state() const { return state_; }
   const Model& model() const { return model_; }
   Model& model() { return model_; }
-  const CellList& cells() const { return cells_; }
+  const Neighbors& neighbors() const { return nb_; }
   const std::array<std::uint64_t, kEventTypes>& event_counts() const { return counts_; }
   std::uint64_t stale_events() const { return stale_; }
   std::uint64_t collisions() const { return counts_[static_cast<int>(EventType::Collision)]; }
@@ -71,76 +107,63 @@ class Simulation {
     now_ = ev.time;
     info.type = ev.type;
     const std::uint32_t i = ev.owner;
-    switch (ev.type) {
-      case EventType::Collision: {
-        const std::uint32_t j = ev.partner;
-        if (state_.count[j] != ev.partner_count) {  // partner moved differently since
-          info.stale = true;
-          ++stale_;
-          predict(i);
-          return info;
-        }
-        state_.advance_to(i, now_);
-        state_.advance_to(j, now_);
-        info.record = model_.collide(state_, box_, i, j, now_);
-        info.record.time = now_;
-        ++state_.count[i];
-        ++state_.count[j];
-        ++counts_[static_cast<int>(EventType::Collision)];
+    if (ev.type == EventType::Collision) {
+      const std::uint32_t j = ev.partner;
+      if (state_.count[j] != ev.partner_count) {  // partner moved differently since
+        info.stale = true;
+        ++stale_;
         predict(i);
-        predict(j);
         return info;
       }
-      case EventType::CellCross: {
-        ++counts_[static_cast<int>(EventType::CellCross)];
-        const int face = static_cast<int>(ev.partner);
-        state_.advance_to(i, now_);
-        if (cells_.cross(i, face)) {
-          const int k = face >> 1;
-          const double s = (face & 1) ? 1.0 : -1.0;
-          state_.r[i][k] -= s * box_.L[k];
-          state_.image[i][k] += (face & 1) ? 1 : -1;
-        }
-        // The trajectory is unchanged: if the remembered best collision is still valid, only
-        // the bodies of the newly adjacent cells need predicting.
-        const Event& b = best_[i];
-        if (b.type == EventType::None || state_.count[b.partner] == b.partner_count) {
-          Event best = b;
-          cand_.clear();
-          shift_.clear();
-          cells_.for_each_new_neighbor(i, face, box_.L, collect());
-          consider(i, best);
-          schedule(i, best);
-        } else {
-          predict(i);
-        }
-        return info;
-      }
-      default:
-        throw std::logic_error("unexpected event type in the calendar");
+      state_.advance_to(i, now_);
+      state_.advance_to(j, now_);
+      info.record = model_.collide(state_, box_, i, j, now_);
+      info.record.time = now_;
+      ++state_.count[i];
+      ++state_.count[j];
+      ++counts_[static_cast<int>(EventType::Collision)];
+      predict(i);
+      predict(j);
+      return info;
     }
+    if (ev.type != Neighbors::kEventType) throw std::logic_error("unexpected event type");
+    ++counts_[static_cast<int>(ev.type)];
+    state_.advance_to(i, now_);
+    cand_.clear();
+    shift_.clear();
+    const bool partial = nb_.handle(i, ev, state_, box_, collect());
+    // The trajectory is unchanged: if the remembered best collision is still valid, only the
+    // new candidates need predicting.
+    const Event& b = best_[i];
+    if (partial && (b.type == EventType::None || state_.count[b.partner] == b.partner_count)) {
+      Event best = b;
+      consider(i, best);
+      schedule(i, best);
+    } else {
+      predict(i);
+    }
+    return info;
   }
 
   // Stream every body to the current time (for output; does not change any trajectory).
   void synchronize() {
     for (std::uint32_t i = 0; i < state_.size(); ++i) state_.advance_to(i, now_);
   }
-  // Mutable access for code that changes velocities of all bodies at once (e.g. rescaling);
-  // call reschedule_all() afterwards.
-  State& mutable_state() { return state_; }
-  void reschedule_all() {
-    synchronize();
-    for (std::uint32_t i = 0; i < state_.size(); ++i) ++state_.count[i];
-    for (std::uint32_t i = 0; i < state_.size(); ++i) predict(i);
-  }
 
  private:
+  auto collect() {
+    return [this](std::uint32_t j, const Vec3& shift) {
+      cand_.push_back(j);
+      shift_.push_back(shift);
+    };
+  }
   // Predict body i against the candidates in cand_ and keep the earliest in `best`.
   void consider(std::uint32_t i, Event& best) {
     const std::size_t n = cand_.size();
     if (times_.size() < n) times_.resize(2 * n);
-    model_.contact_times(state_, box_, i, cand_.data(), shift_.data(), n,
-                         cells_.needs_minimum_image(), now_, times_.data());
+    model_.contact_times(state_, box_, i, cand_.data(),
+                         nb_.needs_minimum_image() ? nullptr : shift_.data(), n, now_,
+                         times_.data());
     std::size_t kbest = n;
     double tbest = best.time - now_;
     for (std::size_t k = 0; k < n; ++k)
@@ -154,46 +177,30 @@ class Simulation {
       best.type = EventType::Collision;
     }
   }
-  auto collect() {
-    return [this](std::uint32_t j, const Vec3& shift) {
-      cand_.push_back(j);
-      shift_.push_back(shift);
-    };
-  }
-  // Full prediction for body i: all bodies in its 27 cells, and its next cell crossing.
+  // Full prediction for body i: all its candidates, and its next neighbour event.
   void predict(std::uint32_t i) {
     state_.advance_to(i, now_);
     Event best;
     best.owner = i;
     cand_.clear();
     shift_.clear();
-    cells_.for_each_neighbor(i, box_.L, collect());
+    nb_.for_each_candidate(i, box_, collect());
     consider(i, best);
     schedule(i, best);
   }
   void schedule(std::uint32_t i, const Event& best) {
     best_[i] = best;
-    int face = -1;
-    const double tc = cells_.crossing_time(i, state_.r[i], state_.v[i], face);
-    if (face >= 0 && now_ + tc < best.time) {
-      Event c;
-      c.time = now_ + tc;
-      c.owner = i;
-      c.partner = static_cast<std::uint32_t>(face);
-      c.type = EventType::CellCross;
-      queue_.set(c);
-    } else {
-      queue_.set(best);
-    }
+    const Event ne = nb_.next_event(i, state_, now_);
+    queue_.set(ne.time < best.time ? ne : best);
   }
 
   Box box_;
   State state_;
   Model model_;
+  Neighbors nb_;
   double now_ = 0.0;
-  CellList cells_;
   Queue queue_;
-  std::vector<Event> best_;  // each body's best predicted collision (for cell crossings)
+  std::vector<Event> best_;          // each body's best predicted collision
   std::vector<std::uint32_t> cand_;  // candidate partners of the body being predicted
   std::vector<Vec3> shift_;          // their periodic image shifts
   std::vector<double> times_;        // their contact times

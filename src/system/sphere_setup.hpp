@@ -3,6 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "neighbors/cell_neighbors.hpp"
+#include "neighbors/shell_neighbors.hpp"
 #include "system/hard_spheres.hpp"
 #include "system/init.hpp"
 #include "system/simulation.hpp"
@@ -16,6 +18,7 @@ struct SphereSystemSpec {
   double mass = 1.0;
   double kT = 1.0;
   std::uint64_t seed = 1;
+  double shell = 0.0;  // neighbour-list shell delta; 0: cell lists
 };
 
 inline Box cubic_box_for(std::size_t n, double body_volume, double phi) {
@@ -25,16 +28,32 @@ inline Box cubic_box_for(std::size_t n, double body_volume, double phi) {
   return box;
 }
 
-inline Simulation<HardSpheres> make_hard_sphere_simulation(const SphereSystemSpec& s) {
+using SphereCellSim = Simulation<HardSpheres, CellNeighbors>;
+using SphereListSim = Simulation<HardSpheres, ShellNeighbors>;
+
+// FCC lattice at the packing fraction, Maxwell–Boltzmann velocities.
+inline State hard_sphere_start(const SphereSystemSpec& s, Box& box) {
   const double v = kPi / 6.0 * s.sigma * s.sigma * s.sigma;
-  const Box box = cubic_box_for(s.n, v, s.phi);
+  box = cubic_box_for(s.n, v, s.phi);
   State st;
   st.resize(s.n);
   double nn = 0.0;
   st.r = fcc_lattice(s.n, box.L.x(), &nn);
   if (nn < s.sigma) throw std::invalid_argument("packing fraction too high for the FCC lattice");
   maxwell_boltzmann(st, s.kT, s.mass, s.seed);
-  return Simulation<HardSpheres>(box, std::move(st), HardSpheres{s.sigma, s.mass});
+  return st;
+}
+
+inline SphereCellSim make_hard_sphere_cell_simulation(const SphereSystemSpec& s) {
+  Box box;
+  State st = hard_sphere_start(s, box);
+  return SphereCellSim(box, std::move(st), HardSpheres{s.sigma, s.mass}, CellNeighbors(s.sigma));
+}
+inline SphereListSim make_hard_sphere_list_simulation(const SphereSystemSpec& s) {
+  Box box;
+  State st = hard_sphere_start(s, box);
+  return SphereListSim(box, std::move(st), HardSpheres{s.sigma, s.mass},
+                       ShellNeighbors(s.sigma, s.shell));
 }
 
 }  // namespace hb

@@ -1,0 +1,142 @@
+// Micro benchmarks of the geometric kernel: distance (cold and warm start) and contact time,
+// for spheres (analytic fast path and the generic solver) and uniaxial ellipsoids X0 = 2, 0.5.
+// Counters: NR iterations per call (distance), distance evaluations and contact-NR iterations
+// per call (contact time).  Fixed seeds; pairs are generated once, outside the timed loop.
+#include <benchmark/benchmark.h>
+
+#include <random>
+#include <vector>
+
+#include "contact/contact_time.hpp"
+#include "geometry/distance.hpp"
+#include "shapes/ellipsoid.hpp"
+
+namespace {
+
+using namespace hb;
+
+struct Gen {
+  std::mt19937_64 g{12345};
+  double uni(double a, double b) { return std::uniform_real_distribution<double>(a, b)(g); }
+  Vec3 unit() {
+    std::normal_distribution<double> n;
+    return Vec3(n(g), n(g), n(g)).normalized();
+  }
+  Quat quat() {
+    std::normal_distribution<double> n;
+    Quat q(n(g), n(g), n(g), n(g));
+    q.normalize();
+    return q;
+  }
+};
+
+// B placed so that the pair is exactly `gap` apart along n (support points, see the tests).
+template <class S>
+Pose place(const S& s, const Pose& pa, const Mat3& Rb, const Vec3& n, double gap) {
+  const Vec3 xa = pa.r + pa.R * s.support_point(pa.R.transpose() * n);
+  return Pose{xa + gap * n - Rb * s.support_point(-(Rb.transpose() * n)), Rb};
+}
+
+struct PairSet {
+  std::vector<Pose> a, b, b_moved;  // b_moved: b after a small motion (for warm starts)
+};
+
+template <class S>
+PairSet make_pairs(const S& s, int n) {
+  Gen g;
+  PairSet p;
+  for (int i = 0; i < n; ++i) {
+    const Pose pa{Vec3(g.uni(-2, 2), g.uni(-2, 2), g.uni(-2, 2)), g.quat().toRotationMatrix()};
+    const double gap = std::exp(g.uni(std::log(1e-4), std::log(1.0)));
+    const Pose pb = place(s, pa, g.quat().toRotationMatrix(), g.unit(), gap);
+    const double eps = 0.02 * gap;
+    p.a.push_back(pa);
+    p.b.push_back(pb);
+    p.b_moved.push_back(Pose{pb.r + eps * g.unit(),
+                             Eigen::AngleAxisd(eps, g.unit()).toRotationMatrix() * pb.R});
+  }
+  return p;
+}
+
+template <class S>
+void distance_bench(benchmark::State& state, const S& s, bool warm, bool analytic) {
+  const PairSet p = make_pairs(s, 1024);
+  DistanceOptions o;
+  o.analytic_spheres = analytic;
+  std::vector<DistanceWarmStart> w(p.a.size());
+  for (size_t i = 0; i < p.a.size(); ++i) w[i] = distance(s, p.a[i], s, p.b[i], o).warm;
+  size_t i = 0;
+  long iters = 0, calls = 0;
+  for (auto _ : state) {
+    const DistanceResult r = distance(s, p.a[i], s, warm ? p.b_moved[i] : p.b[i], o,
+                                      warm ? &w[i] : nullptr);
+    benchmark::DoNotOptimize(r.distance);
+    iters += r.nr_iterations;
+    ++calls;
+    i = (i + 1) % p.a.size();
+  }
+  state.counters["nr_iter"] = double(iters) / calls;
+}
+
+template <class S>
+void contact_bench(benchmark::State& state, const S& s) {
+  Gen g;
+  struct Case { BodyState a, b; double tmax; };
+  std::vector<Case> cases;
+  const double L = s.bounding_radius();
+  for (int i = 0; i < 256; ++i) {
+    const Pose pa{Vec3::Zero(), g.quat().toRotationMatrix()};
+    const Vec3 n = g.unit();
+    const double gap = std::exp(g.uni(std::log(1e-3), std::log(2.0 * L)));
+    const Pose pb = place(s, pa, g.quat().toRotationMatrix(), n, gap);
+    BodyState a{pa.r, Quat(pa.R), Vec3::Zero(), g.unit() * g.uni(0, 1.0 / L)};
+    BodyState b{pb.r, Quat(pb.R), -(n + 0.8 * g.unit() * g.uni(0, 1)).normalized(),
+                g.unit() * g.uni(0, 1.0 / L)};
+    cases.push_back({a, b, 2.0 * (gap + 2 * L)});
+  }
+  size_t i = 0;
+  long evals = 0, nr = 0, calls = 0, hits = 0;
+  for (auto _ : state) {
+    const Case& c = cases[i];
+    const ContactResult r = contact_time(ContactInput<S, S>{s, s, c.a, c.b, 0.0, 0.0, c.tmax, 1e-5 * L});
+    benchmark::DoNotOptimize(r.time);
+    evals += r.distance_evals;
+    nr += r.nr_iterations;
+    hits += r.status == ContactStatus::hit;
+    ++calls;
+    i = (i + 1) % cases.size();
+  }
+  state.counters["dist_evals"] = double(evals) / calls;
+  state.counters["contact_nr_iter"] = double(nr) / calls;
+  state.counters["hit_fraction"] = double(hits) / calls;
+}
+
+const Sphere kSphere{0.5};
+const Ellipsoid kProlate{1.0, 0.5, 0.5};  // X0 = 2 (symmetry axis along x)
+const Ellipsoid kOblate{0.25, 0.5, 0.5};  // X0 = 0.5
+
+void BM_DistanceSphereAnalytic(benchmark::State& s) { distance_bench(s, kSphere, false, true); }
+void BM_DistanceSphereGenericCold(benchmark::State& s) { distance_bench(s, kSphere, false, false); }
+void BM_DistanceSphereGenericWarm(benchmark::State& s) { distance_bench(s, kSphere, true, false); }
+void BM_DistanceEllipsoidX2Cold(benchmark::State& s) { distance_bench(s, kProlate, false, true); }
+void BM_DistanceEllipsoidX2Warm(benchmark::State& s) { distance_bench(s, kProlate, true, true); }
+void BM_DistanceEllipsoidX05Cold(benchmark::State& s) { distance_bench(s, kOblate, false, true); }
+void BM_DistanceEllipsoidX05Warm(benchmark::State& s) { distance_bench(s, kOblate, true, true); }
+void BM_ContactTimeSphereGeneric(benchmark::State& s) { contact_bench(s, kSphere); }
+void BM_ContactTimeEllipsoidX2(benchmark::State& s) { contact_bench(s, kProlate); }
+void BM_ContactTimeEllipsoidX05(benchmark::State& s) { contact_bench(s, kOblate); }
+
+BENCHMARK(BM_DistanceSphereAnalytic);
+BENCHMARK(BM_DistanceSphereGenericCold);
+BENCHMARK(BM_DistanceSphereGenericWarm);
+BENCHMARK(BM_DistanceEllipsoidX2Cold);
+BENCHMARK(BM_DistanceEllipsoidX2Warm);
+BENCHMARK(BM_DistanceEllipsoidX05Cold);
+BENCHMARK(BM_DistanceEllipsoidX05Warm);
+BENCHMARK(BM_ContactTimeSphereGeneric);
+BENCHMARK(BM_ContactTimeEllipsoidX2);
+BENCHMARK(BM_ContactTimeEllipsoidX05);
+
+}  // namespace
+
+BENCHMARK_MAIN();

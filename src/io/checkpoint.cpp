@@ -1,0 +1,230 @@
+#include "io/checkpoint.hpp"
+
+namespace hb::ckpt {
+
+namespace {
+constexpr const char* P = "particles/hardbody/";
+std::string key(const char* k) { return std::string(P) + k; }
+}  // namespace
+
+gsd::LogArray vec3s(const std::vector<Vec3>& v) {
+  gsd::LogArray a{v.size(), 3, {}};
+  a.values.reserve(3 * v.size());
+  for (const auto& x : v) a.values.insert(a.values.end(), {x.x(), x.y(), x.z()});
+  return a;
+}
+gsd::LogArray quats(const std::vector<Quat>& q) {
+  gsd::LogArray a{q.size(), 4, {}};
+  a.values.reserve(4 * q.size());
+  for (const auto& x : q) a.values.insert(a.values.end(), {x.w(), x.x(), x.y(), x.z()});
+  return a;
+}
+gsd::LogArray scalars(const std::vector<double>& v) { return gsd::LogArray{v.size(), 1, v}; }
+gsd::LogArray row(const std::vector<double>& v) {
+  return gsd::LogArray{1, static_cast<std::uint32_t>(std::max<std::size_t>(v.size(), 1)),
+                       v.empty() ? std::vector<double>{0.0} : v};
+}
+gsd::LogArray events(const std::vector<Event>& e) {
+  gsd::LogArray a{e.size(), 4, {}};
+  a.values.reserve(4 * e.size());
+  for (const auto& x : e)
+    a.values.insert(a.values.end(), {x.time, double(x.partner), double(x.partner_count), double(int(x.type))});
+  return a;
+}
+gsd::LogArray encode(const std::vector<std::array<int, 3>>& c) {
+  gsd::LogArray a{c.size(), 3, {}};
+  for (const auto& x : c) a.values.insert(a.values.end(), {double(x[0]), double(x[1]), double(x[2])});
+  return a;
+}
+gsd::LogArray encode(const std::vector<Vec3>& c) { return vec3s(c); }
+
+const std::vector<std::string>& config_signature_names() {
+  static const std::vector<std::string> n = {
+      "system.particles", "system.packing_fraction", "system.seed", "system.temperature",
+      "system.mass", "shape.type", "shape.radius", "shape.semi_axes[0]", "shape.semi_axes[1]",
+      "shape.semi_axes[2]", "shape.exponents[0]", "shape.exponents[1]", "shape.exponents[2]",
+      "shape.inertia", "neighbors.method", "neighbors.shell", "solver.eps_d"};
+  return n;
+}
+std::vector<double> config_signature(const Config& c) {
+  const double type = c.shape.type == "sphere" ? 0 : c.shape.type == "ellipsoid" ? 1 : 2;
+  const double method = c.neighbors_method == "cells" ? 0 : 1;
+  return {double(c.particles), c.packing_fraction, double(c.seed), c.temperature, c.mass, type,
+          c.shape.radius, c.shape.semi_axes[0], c.shape.semi_axes[1], c.shape.semi_axes[2],
+          c.shape.exponents[0], c.shape.exponents[1], c.shape.exponents[2], c.shape.inertia,
+          method, c.shell, c.eps_d};
+}
+
+void fill_frame(gsd::HoomdFrame& f, const State& s, const Box& box, double now, std::uint64_t step,
+                const ShapeSpec& shape) {
+  const std::size_t n = s.size();
+  f.step = step;
+  f.N = static_cast<std::uint32_t>(n);
+  f.box = {float(box.L.x()), float(box.L.y()), float(box.L.z()), 0, 0, 0};
+  f.position.resize(3 * n);
+  f.orientation.resize(4 * n);
+  f.velocity.resize(3 * n);
+  f.image.resize(3 * n);
+  f.type_id.assign(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      // HOOMD boxes are centred on the origin; the engine's box is [0, L).
+      f.position[3 * i + k] = float(s.r[i][k] - 0.5 * box.L[k]);
+      f.velocity[3 * i + k] = float(s.v[i][k]);
+      f.image[3 * i + k] = s.image[i][k];
+    }
+    f.orientation[4 * i] = float(s.q[i].w());
+    f.orientation[4 * i + 1] = float(s.q[i].x());
+    f.orientation[4 * i + 2] = float(s.q[i].y());
+    f.orientation[4 * i + 3] = float(s.q[i].z());
+  }
+  f.types = {shape.type};
+  if (shape.type == "sphere")
+    f.type_shapes = {gsd::sphere_shape(2.0 * shape.radius)};
+  else
+    f.type_shapes = {gsd::ellipsoid_shape(shape.semi_axes.x(), shape.semi_axes.y(), shape.semi_axes.z())};
+  // Exact state in the engine's frame [0, L) (box_origin 0), for analysis and conversion.
+  f.log[key("position_double")] = vec3s(s.r);
+  f.log[key("orientation_double")] = quats(s.q);
+  f.log[key("velocity_double")] = vec3s(s.v);
+  f.log[key("angular_velocity_double")] = vec3s(s.w);
+  f.log["hardbody/time"] = row({now});
+  f.log["hardbody/box_origin"] = row({0.0, 0.0, 0.0});
+  f.log["hardbody/box_double"] = row({box.L.x(), box.L.y(), box.L.z(), 0.0, 0.0, 0.0});
+}
+
+void add_checkpoint_logs(gsd::HoomdFrame& f, const State& s, const LoopSnapshot& loop,
+                         const DriverState& d, const Config& c) {
+  f.log[key("state_r")] = vec3s(s.r);
+  f.log[key("state_v")] = vec3s(s.v);
+  f.log[key("state_q")] = quats(s.q);
+  f.log[key("state_w")] = vec3s(s.w);
+  f.log[key("state_t")] = scalars(s.t);
+  std::vector<double> cnt(s.size());
+  std::vector<Vec3> img(s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    cnt[i] = double(s.count[i]);
+    img[i] = s.image[i].cast<double>();
+  }
+  f.log[key("state_count")] = scalars(cnt);
+  f.log[key("state_image")] = vec3s(img);
+  f.log[key("calendar")] = events(loop.slot);
+  f.log[key("best")] = events(loop.best);
+  std::vector<double> l{loop.now, double(loop.stale)};
+  for (auto x : loop.counts) l.push_back(double(x));
+  f.log["hardbody/loop"] = row(l);
+  std::vector<double> dr{double(d.phase), d.e0, d.coll0, d.stale0, double(d.log_rows),
+                         double(d.frames), d.next_snapshot, d.block_start, d.cpu_prev, d.wall_prev};
+  dr.insert(dr.end(), d.events0.begin(), d.events0.end());
+  f.log["hardbody/driver"] = row(dr);
+  f.log["hardbody/pressure"] = row(d.pressure);
+  f.log["hardbody/config"] = row(config_signature(c));
+}
+
+const gsd::LogArray& Reader::get(const std::string& k, std::uint64_t rows, std::uint32_t cols) const {
+  auto it = f.log.find(k);
+  if (it == f.log.end())
+    throw InputError(fmt::format("{}: not a hardbody checkpoint (chunk log/{} missing)", path, k));
+  if ((rows && it->second.rows != rows) || (cols && it->second.cols != cols) ||
+      it->second.values.size() != it->second.rows * it->second.cols)
+    throw InputError(fmt::format("{}: chunk log/{} has shape {}x{}, expected {}x{}", path, k,
+                                 it->second.rows, it->second.cols, rows, cols));
+  return it->second;
+}
+std::vector<Vec3> Reader::vec3s(const std::string& k, std::uint64_t n) const {
+  const auto& a = get(k, n, 3);
+  std::vector<Vec3> v(n);
+  for (std::size_t i = 0; i < n; ++i) v[i] = Vec3(a.values[3 * i], a.values[3 * i + 1], a.values[3 * i + 2]);
+  return v;
+}
+std::vector<Quat> Reader::quats(const std::string& k, std::uint64_t n) const {
+  const auto& a = get(k, n, 4);
+  std::vector<Quat> v(n);
+  for (std::size_t i = 0; i < n; ++i)
+    v[i] = Quat(a.values[4 * i], a.values[4 * i + 1], a.values[4 * i + 2], a.values[4 * i + 3]);
+  return v;
+}
+std::vector<Event> Reader::events(const std::string& k, std::uint64_t n) const {
+  const auto& a = get(k, n, 4);
+  std::vector<Event> v(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    v[i].time = a.values[4 * i];
+    v[i].owner = static_cast<std::uint32_t>(i);
+    v[i].partner = static_cast<std::uint32_t>(a.values[4 * i + 1]);
+    v[i].partner_count = static_cast<std::uint32_t>(a.values[4 * i + 2]);
+    const int t = static_cast<int>(a.values[4 * i + 3]);
+    if (t < 0 || t >= kEventTypes) throw InputError(fmt::format("{}: corrupt event record", path));
+    v[i].type = EventType(t);
+    if (v[i].type == EventType::Collision && v[i].partner >= n)
+      throw InputError(fmt::format("{}: corrupt event record (partner {})", path, v[i].partner));
+  }
+  return v;
+}
+std::vector<double> Reader::row(const std::string& k) const { return get(k, 1, 0).values; }
+
+Reader open(const std::string& path, const Config& c) {
+  Reader r;
+  r.path = path;
+  try {
+    r.f = gsd::read_last_frame(path);
+  } catch (const std::exception& e) {
+    throw InputError(e.what());
+  }
+  const auto sig = r.row("hardbody/config");
+  const auto want = config_signature(c);
+  const auto& names = config_signature_names();
+  if (sig.size() != want.size())
+    throw InputError(fmt::format("{}: checkpoint from an incompatible hardbody version", path));
+  for (std::size_t k = 0; k < want.size(); ++k)
+    if (sig[k] != want[k])
+      throw InputError(fmt::format(
+          "{}: checkpoint was written with a different configuration ({} = {} there, {} in {})",
+          path, names[k], sig[k], want[k], c.source));
+  if (r.f.N != c.particles)
+    throw InputError(fmt::format("{}: checkpoint has {} particles, config {}", path, r.f.N, c.particles));
+  return r;
+}
+
+void read_core(const Reader& r, Box& box, State& s, LoopSnapshot& loop, DriverState& d) {
+  const std::uint64_t n = r.f.N;
+  const auto b = r.row("hardbody/box_double");
+  if (b.size() != 6) throw InputError(fmt::format("{}: bad box record", r.path));
+  box.L = Vec3(b[0], b[1], b[2]);
+  s.resize(n);
+  s.r = r.vec3s(key("state_r"), n);
+  s.v = r.vec3s(key("state_v"), n);
+  s.q = r.quats(key("state_q"), n);
+  s.w = r.vec3s(key("state_w"), n);
+  s.t = r.get(key("state_t"), n, 1).values;
+  const auto& cnt = r.get(key("state_count"), n, 1).values;
+  const auto img = r.vec3s(key("state_image"), n);
+  for (std::size_t i = 0; i < n; ++i) {
+    s.count[i] = static_cast<std::uint32_t>(cnt[i]);
+    s.image[i] = img[i].cast<int>();
+  }
+  loop.slot = r.events(key("calendar"), n);
+  loop.best = r.events(key("best"), n);
+  const auto l = r.row("hardbody/loop");
+  if (l.size() != 2 + kEventTypes) throw InputError(fmt::format("{}: bad loop record", r.path));
+  loop.now = l[0];
+  loop.stale = std::uint64_t(l[1]);
+  for (int k = 0; k < kEventTypes; ++k) loop.counts[k] = std::uint64_t(l[2 + k]);
+  const auto dr = r.row("hardbody/driver");
+  if (dr.size() != 10 + kEventTypes) throw InputError(fmt::format("{}: bad driver record", r.path));
+  d.phase = int(dr[0]);
+  d.e0 = dr[1], d.coll0 = dr[2], d.stale0 = dr[3];
+  d.log_rows = std::uint64_t(dr[4]), d.frames = std::uint64_t(dr[5]);
+  d.next_snapshot = dr[6], d.block_start = dr[7], d.cpu_prev = dr[8], d.wall_prev = dr[9];
+  for (int k = 0; k < kEventTypes; ++k) d.events0[k] = dr[10 + k];
+  d.pressure = r.row("hardbody/pressure");
+  if (d.pressure.size() == 1) d.pressure.clear();
+}
+
+void decode(const Reader& r, std::vector<std::array<int, 3>>& out) {
+  const auto v = r.vec3s(key("neighbors"), r.f.N);
+  out.resize(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) out[i] = {int(v[i].x()), int(v[i].y()), int(v[i].z())};
+}
+void decode(const Reader& r, std::vector<Vec3>& out) { out = r.vec3s(key("neighbors"), r.f.N); }
+
+}  // namespace hb::ckpt

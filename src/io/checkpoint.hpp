@@ -1,0 +1,111 @@
+// Trajectory frames and checkpoints in GSD (HOOMD schema). A checkpoint holds, besides the
+// OVITO-readable frame, the exact double-precision state at the bodies' own time stamps, the
+// event calendar, the neighbour structure and the driver's accumulators, so that
+// `hardbody run --resume` continues bit for bit.
+#pragma once
+#include <array>
+#include <fmt/format.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "io/config.hpp"
+#include "io/gsd_hoomd.hpp"
+#include "io/run.hpp"
+#include "system/box.hpp"
+#include "system/simulation.hpp"
+#include "system/state.hpp"
+
+namespace hb {
+
+// What the run driver accumulates (checkpointed with the state).
+struct DriverState {
+  int phase = 0;  // 0 equilibrating, 1 measuring, 2 done
+  double e0 = 0.0, coll0 = 0.0, stale0 = 0.0;
+  std::array<double, kEventTypes> events0{};
+  std::uint64_t log_rows = 0, frames = 0;
+  double next_snapshot = 0.0, block_start = 0.0;
+  double cpu_prev = 0.0, wall_prev = 0.0;  // measured-phase seconds of earlier sessions
+  std::vector<double> pressure;            // VirialPressure::save()
+};
+
+// A copy of the state with every body streamed to the current time and wrapped into the box.
+template <class Sim>
+State synchronized_state(const Sim& sim) {
+  State s = sim.state();
+  for (std::uint32_t i = 0; i < s.size(); ++i) {
+    s.advance_to(i, sim.now());
+    s.image[i] += sim.box().wrap(s.r[i]);
+  }
+  return s;
+}
+
+namespace ckpt {
+gsd::LogArray vec3s(const std::vector<Vec3>& v);
+gsd::LogArray quats(const std::vector<Quat>& q);
+gsd::LogArray scalars(const std::vector<double>& v);
+gsd::LogArray row(const std::vector<double>& v);
+gsd::LogArray events(const std::vector<Event>& e);
+gsd::LogArray cells(const std::vector<std::array<int, 3>>& c);
+std::vector<double> config_signature(const Config& c);
+const std::vector<std::string>& config_signature_names();
+void fill_frame(gsd::HoomdFrame& f, const State& synced, const Box& box, double now,
+                std::uint64_t step, const ShapeSpec& shape);
+void add_checkpoint_logs(gsd::HoomdFrame& f, const State& s, const LoopSnapshot& loop,
+                         const DriverState& d, const Config& c);
+
+// Reading back (throw InputError naming the file and the problem).
+struct Reader {
+  std::string path;
+  gsd::HoomdFrame f;
+  const gsd::LogArray& get(const std::string& key, std::uint64_t rows, std::uint32_t cols) const;
+  std::vector<Vec3> vec3s(const std::string& key, std::uint64_t n) const;
+  std::vector<Quat> quats(const std::string& key, std::uint64_t n) const;
+  std::vector<Event> events(const std::string& key, std::uint64_t n) const;
+  std::vector<double> row(const std::string& key) const;
+};
+Reader open(const std::string& path, const Config& c);
+void read_core(const Reader& r, Box& box, State& s, LoopSnapshot& loop, DriverState& d);
+void decode(const Reader& r, std::vector<std::array<int, 3>>& out);
+void decode(const Reader& r, std::vector<Vec3>& out);
+gsd::LogArray encode(const std::vector<std::array<int, 3>>& c);
+gsd::LogArray encode(const std::vector<Vec3>& c);
+}  // namespace ckpt
+
+// One trajectory frame (synchronised positions) at the simulation's current time.
+template <class Sim>
+gsd::HoomdFrame make_frame(const Sim& sim, const ShapeSpec& shape, bool, const void*) {
+  gsd::HoomdFrame f;
+  ckpt::fill_frame(f, synchronized_state(sim), sim.box(), sim.now(), sim.collisions(), shape);
+  return f;
+}
+
+template <class Sim>
+gsd::HoomdFrame make_checkpoint(const Sim& sim, const ShapeSpec& shape, const Config& c,
+                                const DriverState& d) {
+  gsd::HoomdFrame f = make_frame(sim, shape, true, nullptr);
+  ckpt::add_checkpoint_logs(f, sim.state(), sim.snapshot(), d, c);
+  f.log["particles/hardbody/neighbors"] = ckpt::encode(sim.neighbors().snapshot());
+  return f;
+}
+
+template <class Nb>
+struct Restored {
+  Box box;
+  State state;
+  LoopSnapshot loop;
+  DriverState driver;
+  decltype(std::declval<const Nb&>().snapshot()) neighbors;
+};
+
+template <class Nb>
+Restored<Nb> read_checkpoint(const std::string& path, const Config& c) {
+  Restored<Nb> r;
+  const ckpt::Reader rd = ckpt::open(path, c);
+  ckpt::read_core(rd, r.box, r.state, r.loop, r.driver);
+  ckpt::decode(rd, r.neighbors);
+  return r;
+}
+
+}  // namespace hb
