@@ -83,6 +83,76 @@ void TimeCorrelations::reset() {
   count_.assign(m, 0);
 }
 
+namespace {
+constexpr double kCorrelationsRecord = 1.0;  // record version
+}
+
+std::vector<double> TimeCorrelations::save() const {
+  const std::size_t m = lags_.size();
+  std::vector<double> d{kCorrelationsRecord, double(m), double(spec_.max_lag_samples),
+                        double(origin_every_), double(origins_.size()), double(next_sample_),
+                        first_time_, double(n_), box_L_.x(), box_L_.y(), box_L_.z(),
+                        double(qs_.size())};
+  for (const auto* v : {&sum_msd_, &sum_r4_, &sum_c1_, &sum_c2_, &sum_fs_}) d.insert(d.end(), v->begin(), v->end());
+  for (auto c : count_) d.push_back(double(c));
+  for (const auto& q : qs_) d.insert(d.end(), {q.x(), q.y(), q.z()});
+  for (const auto& o : origins_) {
+    d.push_back(double(o.index));
+    if (o.index < 0) continue;
+    for (const auto* v : {&o.r, &o.u})
+      for (const auto& x : *v) d.insert(d.end(), {x.x(), x.y(), x.z()});
+  }
+  return d;
+}
+
+void TimeCorrelations::load(const std::vector<double>& d) {
+  auto fail = [](const char* why) {
+    throw std::invalid_argument(std::string("time-correlation record: ") + why);
+  };
+  const std::size_t m = lags_.size();
+  if (d.size() < 12 || d[0] != kCorrelationsRecord) fail("unknown version or too short");
+  if (d[1] != double(m) || d[2] != double(spec_.max_lag_samples) || d[3] != double(origin_every_) ||
+      d[4] != double(origins_.size()))
+    fail("written with another lag grid or origin spacing");
+  const std::size_t n = std::size_t(d[7]), nq = std::size_t(d[11]);
+  std::size_t at = 12;
+  auto take = [&](std::size_t k) {
+    if (d.size() - at < k) fail("truncated");
+    const std::size_t from = at;
+    at += k;
+    return d.begin() + std::ptrdiff_t(from);
+  };
+  auto vecs = [&](std::vector<Vec3>& out, std::size_t k) {
+    auto it = take(3 * k);
+    out.resize(k);
+    for (auto& x : out) {
+      x = Vec3(it[0], it[1], it[2]);
+      it += 3;
+    }
+  };
+  std::vector<double>* sums[] = {&sum_msd_, &sum_r4_, &sum_c1_, &sum_c2_, &sum_fs_};
+  for (auto* v : sums) {
+    auto it = take(m);
+    v->assign(it, it + std::ptrdiff_t(m));
+  }
+  {
+    auto it = take(m);
+    for (std::size_t j = 0; j < m; ++j) count_[j] = std::int64_t(it[std::ptrdiff_t(j)]);
+  }
+  vecs(qs_, nq);
+  for (auto& o : origins_) {
+    o.index = std::int64_t(*take(1));
+    if (o.index < 0) continue;
+    vecs(o.r, n);
+    vecs(o.u, n);
+  }
+  if (at != d.size()) fail("trailing data");
+  next_sample_ = std::int64_t(d[5]);
+  first_time_ = d[6];
+  n_ = n;
+  box_L_ = Vec3(d[8], d[9], d[10]);
+}
+
 void TimeCorrelations::init_q(const Box& box) {
   box_L_ = box.L;
   qs_.clear();

@@ -71,6 +71,11 @@ class TimeCorrelations {
   void sample(double time, const State& state, const Box& box);
   // Forget all origins and sums (e.g. at the end of equilibration).
   void reset();
+  // Flat serialisation for checkpoints (exact doubles; includes the live origins, so about
+  // 6 N doubles per origin). load() needs an object built from the same spec and throws
+  // std::invalid_argument on a record that does not match it.
+  std::vector<double> save() const;
+  void load(const std::vector<double>& record);
 
   const CorrelationSpec& spec() const { return spec_; }
   int effective_origin_every() const { return origin_every_; }

@@ -136,6 +136,24 @@ void RadialDistribution::sample(double time, const State& state, const Box& box)
   sum_pair_density_ += 0.5 * double(n) * (double(n) - 1.0) / box.volume();
 }
 
+std::vector<double> RadialDistribution::save() const {
+  std::vector<double> d{r_max_, double(samples_), double(last_n_), sum_pair_density_, sum_n_,
+                        double(hist_.size())};
+  for (auto h : hist_) d.push_back(double(h));
+  return d;
+}
+
+void RadialDistribution::load(const std::vector<double>& d) {
+  if (d.size() < 6 || d[5] != double(hist_.size()) || d.size() != 6 + hist_.size())
+    throw std::invalid_argument("g(r) record: wrong length or bin count");
+  r_max_ = d[0];
+  samples_ = int(d[1]);
+  last_n_ = std::size_t(d[2]);
+  sum_pair_density_ = d[3];
+  sum_n_ = d[4];
+  for (std::size_t k = 0; k < hist_.size(); ++k) hist_[k] = std::uint64_t(d[6 + k]);
+}
+
 std::vector<double> RadialDistribution::r() const {
   std::vector<double> r(hist_.size());
   const double dr = r_max_ / double(hist_.size());
@@ -219,6 +237,26 @@ void NematicOrder::sample(double time, const State& state, const Box& /*box*/) {
   }
   times_.push_back(time);
   series_.push_back(nematic_order(q_, axis_));
+}
+
+std::vector<double> NematicOrder::save() const {
+  std::vector<double> d;
+  d.reserve(8 * times_.size());
+  for (std::size_t k = 0; k < times_.size(); ++k) {
+    const auto& s = series_[k];
+    d.insert(d.end(), {times_[k], s.S2, s.director.x(), s.director.y(), s.director.z(),
+                       s.eigenvalues.x(), s.eigenvalues.y(), s.eigenvalues.z()});
+  }
+  return d;
+}
+
+void NematicOrder::load(const std::vector<double>& d) {
+  if (d.size() % 8 != 0) throw std::invalid_argument("nematic record: length is not a multiple of 8");
+  reset();
+  for (std::size_t k = 0; k < d.size(); k += 8) {
+    times_.push_back(d[k]);
+    series_.push_back({d[k + 1], Vec3(d[k + 2], d[k + 3], d[k + 4]), Vec3(d[k + 5], d[k + 6], d[k + 7])});
+  }
 }
 
 MeanError NematicOrder::S2() const {

@@ -43,6 +43,10 @@ class RadialDistribution {
   // Throws std::invalid_argument if r_max exceeds half the shortest box edge.
   void sample(double time, const State& state, const Box& box);
   void reset();
+  // Flat serialisation for checkpoints; load() throws std::invalid_argument on a record whose
+  // bin count differs.
+  std::vector<double> save() const;
+  void load(const std::vector<double>& record);
 
   double r_max() const { return r_max_; }  // 0 until the first sample when spec.r_max == 0
   int samples() const { return samples_; }
@@ -87,6 +91,9 @@ class NematicOrder {
   // Evaluate S2 and the director at `time` and append them to the series.
   void sample(double time, const State& state, const Box& box);
   void reset();
+  // Flat serialisation for checkpoints (the whole series).
+  std::vector<double> save() const;
+  void load(const std::vector<double>& record);
 
   const std::vector<double>& times() const { return times_; }
   const std::vector<NematicResult>& series() const { return series_; }

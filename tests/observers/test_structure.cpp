@@ -227,3 +227,30 @@ TEST(NematicOrder, PartialOrderAndSeries) {
   }
   EXPECT_EQ(line, "time\tS2\tdirector_x\tdirector_y\tdirector_z");
 }
+
+TEST(Structure, SaveLoadRoundTrip) {
+  pcg32 rng(28);
+  Box box;
+  box.L = Vec3::Constant(9.0);
+  RdfSpec spec;
+  spec.bins = 30;
+  RadialDistribution a(spec), b(spec);
+  NematicOrder na, nb;
+  State s = state_at(uniform_points(300, box, rng));
+  for (auto& q : s.q) q = random_quat(rng);
+  a.sample(0.0, s, box);
+  na.sample(0.0, s, box);
+  b.load(a.save());
+  nb.load(na.save());
+  s.r = uniform_points(300, box, rng);
+  a.sample(1.0, s, box);
+  b.sample(1.0, s, box);
+  na.sample(1.0, s, box);
+  nb.sample(1.0, s, box);
+  EXPECT_EQ(a.to_tsv(), b.to_tsv());
+  EXPECT_EQ(na.to_tsv(), nb.to_tsv());
+  RdfSpec other = spec;
+  other.bins = 31;
+  RadialDistribution c(other);
+  EXPECT_THROW(c.load(a.save()), std::invalid_argument);
+}
