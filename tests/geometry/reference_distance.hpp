@@ -10,8 +10,9 @@
 // support points of A along n and of B along -n) and its Hessian -(H_A(n) + H_B(-n)).
 // We maximise s on the unit sphere by a Riemannian Newton method (tangent-plane Newton step,
 // gradient step when the tangent Hessian is not negative definite, backtracking so that s never
-// decreases), from the centre-line direction and then, if the result is not positive, from 48
-// more directions spread over the sphere (Fibonacci lattice), keeping the best.
+// decreases), from the hint (if any) and the centre-line direction and then, if the result is
+// not positive, from `extra_starts` (default 48) more directions spread over the sphere
+// (Fibonacci lattice), keeping the best.
 // Certification: when the bodies are separated, every local maximum with s > 0 is the global one
 // (h_K is convex for the Minkowski difference K, so the minimum of h_K on the unit ball is a
 // convex problem whose negative minimum lies on the sphere), so one positive result is final.
@@ -100,7 +101,7 @@ double maximise_on_sphere(const Sep& S, Vec3& n, double scale, int& iterations) 
 
 template <SupportShape SA, SupportShape SB>
 RefDistance reference_distance(const SA& a, const Pose& pa, const SB& b, const Pose& pb,
-                               const Vec3* hint = nullptr) {
+                               const Vec3* hint = nullptr, int extra_starts = 48) {
   const Separation<SA, SB> S{a, b, pa, pb};
   const double scale = a.bounding_radius() + b.bounding_radius() + (pb.r - pa.r).norm();
   RefDistance out;
@@ -117,7 +118,7 @@ RefDistance reference_distance(const SA& a, const Pose& pa, const SB& b, const P
   if (hint) try_from(*hint);
   try_from(pb.r - pa.r);
   if (!(out.distance > 0.0)) {
-    const int m = 48;
+    const int m = extra_starts;
     const double golden = kPi * (3.0 - std::sqrt(5.0));
     for (int i = 0; i < m; ++i) {
       const double z = 1.0 - (2.0 * i + 1.0) / m;
