@@ -1,5 +1,7 @@
 // Micro benchmarks of the geometric kernel: distance (cold and warm start) and contact time,
-// for spheres (analytic fast path and the generic solver) and uniaxial ellipsoids X0 = 2, 0.5.
+// for spheres (analytic fast path and the generic solver) and uniaxial ellipsoids X0 = 2, 0.5
+// (8-equation system by default; *5eq: the 5-equation system).  The sphere contact-time case
+// uses the analytic sphere distance inside the generic contact solver.
 // Counters: NR iterations per call (distance), distance evaluations and contact-NR iterations
 // per call (contact time).  Fixed seeds; pairs are generated once, outside the timed loop.
 #include <benchmark/benchmark.h>
@@ -59,10 +61,12 @@ PairSet make_pairs(const S& s, int n) {
 }
 
 template <class S>
-void distance_bench(benchmark::State& state, const S& s, bool warm, bool analytic) {
+void distance_bench(benchmark::State& state, const S& s, bool warm, bool analytic,
+                    DistanceSystem sys = DistanceSystem::eight) {
   const PairSet p = make_pairs(s, 1024);
   DistanceOptions o;
   o.analytic_spheres = analytic;
+  o.system = sys;
   std::vector<DistanceWarmStart> w(p.a.size());
   for (size_t i = 0; i < p.a.size(); ++i) w[i] = distance(s, p.a[i], s, p.b[i], o).warm;
   size_t i = 0;
@@ -120,9 +124,15 @@ void BM_DistanceSphereGenericCold(benchmark::State& s) { distance_bench(s, kSphe
 void BM_DistanceSphereGenericWarm(benchmark::State& s) { distance_bench(s, kSphere, true, false); }
 void BM_DistanceEllipsoidX2Cold(benchmark::State& s) { distance_bench(s, kProlate, false, true); }
 void BM_DistanceEllipsoidX2Warm(benchmark::State& s) { distance_bench(s, kProlate, true, true); }
+void BM_DistanceEllipsoidX2Cold5eq(benchmark::State& s) {
+  distance_bench(s, kProlate, false, true, DistanceSystem::five);
+}
+void BM_DistanceEllipsoidX2Warm5eq(benchmark::State& s) {
+  distance_bench(s, kProlate, true, true, DistanceSystem::five);
+}
 void BM_DistanceEllipsoidX05Cold(benchmark::State& s) { distance_bench(s, kOblate, false, true); }
 void BM_DistanceEllipsoidX05Warm(benchmark::State& s) { distance_bench(s, kOblate, true, true); }
-void BM_ContactTimeSphereGeneric(benchmark::State& s) { contact_bench(s, kSphere); }
+void BM_ContactTimeSphere(benchmark::State& s) { contact_bench(s, kSphere); }
 void BM_ContactTimeEllipsoidX2(benchmark::State& s) { contact_bench(s, kProlate); }
 void BM_ContactTimeEllipsoidX05(benchmark::State& s) { contact_bench(s, kOblate); }
 
@@ -131,9 +141,11 @@ BENCHMARK(BM_DistanceSphereGenericCold);
 BENCHMARK(BM_DistanceSphereGenericWarm);
 BENCHMARK(BM_DistanceEllipsoidX2Cold);
 BENCHMARK(BM_DistanceEllipsoidX2Warm);
+BENCHMARK(BM_DistanceEllipsoidX2Cold5eq);
+BENCHMARK(BM_DistanceEllipsoidX2Warm5eq);
 BENCHMARK(BM_DistanceEllipsoidX05Cold);
 BENCHMARK(BM_DistanceEllipsoidX05Warm);
-BENCHMARK(BM_ContactTimeSphereGeneric);
+BENCHMARK(BM_ContactTimeSphere);
 BENCHMARK(BM_ContactTimeEllipsoidX2);
 BENCHMARK(BM_ContactTimeEllipsoidX05);
 

@@ -272,5 +272,67 @@ TEST(Contact, GrazingCoarseEpsVsReference) {
   EXPECT_EQ(st.false_hits, 0);
 }
 
+
+// contact_time(A, B) == contact_time(B, A): same time, same point, opposite normal.
+TEST(Contact, SymmetricInAandB) {
+  Rng r(48);
+  for (int k = 0; k < scaled_count(1000); ++k) {
+    const Scenario s = make_scenario(r, k % 2);
+    const ContactResult ab = contact_time(
+        ContactInput<Ellipsoid, Ellipsoid>{s.a, s.b, s.sa, s.sb, 0.0, 0.0, s.t_max, 1e-5});
+    const ContactResult ba = contact_time(
+        ContactInput<Ellipsoid, Ellipsoid>{s.b, s.a, s.sb, s.sa, 0.0, 0.0, s.t_max, 1e-5});
+    ASSERT_EQ(ab.status, ba.status) << k;
+    if (ab.status != ContactStatus::hit) continue;
+    EXPECT_NEAR(ab.time, ba.time, 1e-10 * std::max(1.0, ab.time));
+    EXPECT_LE((ab.point - ba.point).norm(), 1e-6);
+    EXPECT_LE((ab.normal + ba.normal).norm(), 1e-6);
+  }
+}
+
+// Just after a collision the pair touches (d ~ -1e-15) and separates: no spurious contact at
+// t = 0; the same pair approaching is a contact at once (initial overlap).
+TEST(Contact, TouchingPairSeparatingIsNotAContact) {
+  Rng r(49);
+  for (int k = 0; k < 200; ++k) {
+    const Ellipsoid a = r.ellipsoid(5.0), b = r.ellipsoid(5.0);
+    const Pose pa{r.ball(1.0), r.rotation()};
+    const Vec3 n = r.unit();
+    const Pose pb = testing::place_at_distance(a, pa, b, r.rotation(), n, -1e-14);
+    BodyState sa{pa.r, Quat(pa.R), Vec3::Zero(), Vec3::Zero()};
+    BodyState sb{pb.r, Quat(pb.R), 0.5 * n + 0.3 * r.unit().cross(n), Vec3::Zero()};
+    const ContactResult leave = contact_time(
+        ContactInput<Ellipsoid, Ellipsoid>{a, b, sa, sb, 0.0, 0.0, 10.0, 1e-5});
+    EXPECT_EQ(leave.status, ContactStatus::none) << k << " t " << leave.time;
+    sb.v = -sb.v;
+    const ContactResult come = contact_time(
+        ContactInput<Ellipsoid, Ellipsoid>{a, b, sa, sb, 0.0, 0.0, 10.0, 1e-5});
+    ASSERT_EQ(come.status, ContactStatus::hit);
+    EXPECT_EQ(come.time, 0.0);
+    EXPECT_TRUE(come.initial_overlap);
+  }
+}
+
+// A window that excludes the contact gives none; t_start/t_state offsets are honoured.
+TEST(Contact, WindowAndStateTime) {
+  const Ellipsoid a{1.0, 0.5, 0.5}, b{0.5, 0.5, 1.0};
+  BodyState sa, sb;
+  sb.r = Vec3(5.0, 0, 0);
+  sb.v = Vec3(-1.0, 0, 0);  // contact when the centre gap is 1.5: at t = 3.5 after t_state
+  const double ts = 10.0;
+  ContactResult c = contact_time(ContactInput<Ellipsoid, Ellipsoid>{a, b, sa, sb, ts, ts, ts + 100, 1e-6});
+  ASSERT_EQ(c.status, ContactStatus::hit);
+  EXPECT_NEAR(c.time, ts + 3.5, 1e-12);
+  EXPECT_LE((c.point - Vec3(1.0, 0, 0)).norm(), 1e-6);
+  EXPECT_LE((c.normal - Vec3::UnitX()).norm(), 1e-9);
+  c = contact_time(ContactInput<Ellipsoid, Ellipsoid>{a, b, sa, sb, ts, ts, ts + 3.4, 1e-6});
+  EXPECT_EQ(c.status, ContactStatus::none);
+  c = contact_time(ContactInput<Ellipsoid, Ellipsoid>{a, b, sa, sb, ts, ts + 3.6, ts + 100, 1e-6});
+  // starting inside the overlap while still approaching: contact at once
+  ASSERT_EQ(c.status, ContactStatus::hit);
+  EXPECT_EQ(c.time, ts + 3.6);
+  EXPECT_TRUE(c.initial_overlap);
+}
+
 }  // namespace
 }  // namespace hb
