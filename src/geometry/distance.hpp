@@ -43,9 +43,13 @@
 // alpha = sqrt(|grad f| / |grad g|), beta = (x_B - x_A).grad f / |grad f|^2.  A warm start is
 // the previous solution of the same pair (its points in each body's own frame, alpha, beta).
 //
+// Systems: the 8-equation system is used from cold guesses (on the random test set it never
+// needed a fallback; the 5-equation one did in 7 of 10,000 pairs), the 5-equation system from
+// warm starts, where it converges as reliably and its 5x5 LU makes a call ~30 % cheaper.
+//
 // Fallbacks (never silent; the result says which attempt succeeded):
-//   1. NR (8 or 5 equations, as chosen) from the warm start, or from the cold guess;
-//   2. if 1 used a warm start: the cold guess;
+//   1. NR (options.warm_system) from the warm start, if one is given;
+//   2. NR (options.system) from the cold guess;
 //   3. a long steepest descent (tight angle) followed by NR on the 8-equation system;
 //   4. the 5-equation system from the same guess;
 //   5. the 8-equation system from the centre-line guess without SD.
@@ -69,7 +73,8 @@ enum class DistanceSystem { eight, five };
 enum class DistanceGuess { scaled, center_line };
 
 struct DistanceOptions {
-  DistanceSystem system = DistanceSystem::eight;
+  DistanceSystem system = DistanceSystem::eight;       // cold starts (0 fallbacks in tests)
+  DistanceSystem warm_system = DistanceSystem::five;   // warm starts (~30 % cheaper per call)
   DistanceGuess guess = DistanceGuess::scaled;
   double tol = 1e-12;        // NR converged when a full step moves points < tol * L
   int max_nr_iter = 60;
@@ -419,7 +424,7 @@ DistanceResult distance(const SA& a, const Pose& pa, const SB& b, const Pose& pb
     w.xa = warm->xa_body;
     w.xb = B.to_frame(warm->xb_body);
     w = multipliers(A, B, w.xa, w.xb);
-    run(1, w, o.system);
+    run(1, w, o.warm_system);
   }
   // 2. cold guess + short SD
   Vec3 xa, xb;
