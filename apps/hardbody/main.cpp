@@ -4,7 +4,11 @@
 #include <cstdio>
 #include <exception>
 
+#include <string>
+#include <unistd.h>
+
 #include "io/config.hpp"
+#include "io/convert.hpp"
 #include "io/run.hpp"
 
 int main(int argc, char** argv) {
@@ -19,6 +23,16 @@ int main(int argc, char** argv) {
   cmd_run->add_flag("--resume", run.resume, "continue from checkpoint.gsd in the output directory");
   cmd_run->add_flag("--quiet", run.quiet, "no progress line");
 
+  std::string conv_in, conv_out, conv_to = "xyz";
+  auto* cmd_conv = app.add_subcommand("convert", "convert a GSD trajectory (extended XYZ for OVITO)");
+  cmd_conv->add_option("trajectory", conv_in, "GSD file")->required();
+  cmd_conv->add_option("--to", conv_to, "output format")->check(CLI::IsMember({"xyz"}));
+  cmd_conv->add_option("-o,--output", conv_out, "output file (default: input with .xyz)");
+
+  std::string plot_dir;
+  auto* cmd_plot = app.add_subcommand("plot", "write PNG plots of a run directory");
+  cmd_plot->add_option("run_dir", plot_dir, "run directory")->required();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -27,6 +41,26 @@ int main(int argc, char** argv) {
   }
   try {
     if (cmd_run->parsed()) hb::run_simulation(run);
+    if (cmd_conv->parsed()) {
+      if (conv_out.empty()) {
+        conv_out = conv_in;
+        const auto dot = conv_out.rfind(".gsd");
+        if (dot != std::string::npos) conv_out.erase(dot);
+        conv_out += ".xyz";
+      }
+      try {
+        hb::convert_gsd_to_xyz(conv_in, conv_out);
+      } catch (const std::runtime_error& e) {
+        throw hb::InputError(e.what());
+      }
+    }
+    if (cmd_plot->parsed()) {
+      // The plots are Python (matplotlib); Debian's interpreter sees python3-matplotlib.
+      const std::string script = std::string(HB_PYTHON_DIR) + "/hardbody_plot.py";
+      execl("/usr/bin/python3", "python3", script.c_str(), plot_dir.c_str(), (char*)nullptr);
+      std::perror("hardbody plot: cannot start /usr/bin/python3");
+      return 3;
+    }
     return 0;
   } catch (const hb::ConfigError& e) {
     std::fprintf(stderr, "hardbody: error: %s\n", e.what());

@@ -114,10 +114,14 @@ void add_checkpoint_logs(gsd::HoomdFrame& f, const State& s, const LoopSnapshot&
   for (auto x : loop.counts) l.push_back(double(x));
   f.log["hardbody/loop"] = row(l);
   std::vector<double> dr{double(d.phase), d.e0, d.coll0, d.stale0, double(d.log_rows),
-                         double(d.frames), d.next_snapshot, d.block_start, d.cpu_prev, d.wall_prev};
+                         double(d.frames), d.next_snapshot, d.block_start, d.cpu_prev, d.wall_prev,
+                         d.next_corr, d.next_gr};
   dr.insert(dr.end(), d.events0.begin(), d.events0.end());
   f.log["hardbody/driver"] = row(dr);
   f.log["hardbody/pressure"] = row(d.pressure);
+  f.log["hardbody/obs_correlations"] = row(d.corr);
+  f.log["hardbody/obs_gr"] = row(d.gr);
+  f.log["hardbody/obs_nematic"] = row(d.nematic);
   f.log["hardbody/config"] = row(config_signature(c));
 }
 
@@ -210,14 +214,23 @@ void read_core(const Reader& r, Box& box, State& s, LoopSnapshot& loop, DriverSt
   loop.stale = std::uint64_t(l[1]);
   for (int k = 0; k < kEventTypes; ++k) loop.counts[k] = std::uint64_t(l[2 + k]);
   const auto dr = r.row("hardbody/driver");
-  if (dr.size() != 10 + kEventTypes) throw InputError(fmt::format("{}: bad driver record", r.path));
+  if (dr.size() != 12 + kEventTypes) throw InputError(fmt::format("{}: bad driver record", r.path));
   d.phase = int(dr[0]);
   d.e0 = dr[1], d.coll0 = dr[2], d.stale0 = dr[3];
   d.log_rows = std::uint64_t(dr[4]), d.frames = std::uint64_t(dr[5]);
   d.next_snapshot = dr[6], d.block_start = dr[7], d.cpu_prev = dr[8], d.wall_prev = dr[9];
-  for (int k = 0; k < kEventTypes; ++k) d.events0[k] = dr[10 + k];
-  d.pressure = r.row("hardbody/pressure");
-  if (d.pressure.size() == 1) d.pressure.clear();
+  d.next_corr = dr[10], d.next_gr = dr[11];
+  for (int k = 0; k < kEventTypes; ++k) d.events0[k] = dr[12 + k];
+  // rows of length 1 holding 0 stand for empty records (GSD chunks need at least one value)
+  auto record = [&](const char* k) {
+    auto v = r.row(k);
+    if (v.size() == 1 && v[0] == 0.0) v.clear();
+    return v;
+  };
+  d.pressure = record("hardbody/pressure");
+  d.corr = record("hardbody/obs_correlations");
+  d.gr = record("hardbody/obs_gr");
+  d.nematic = record("hardbody/obs_nematic");
 }
 
 void decode(const Reader& r, std::vector<std::array<int, 3>>& out) {

@@ -28,6 +28,8 @@ struct DriverState {
   double next_snapshot = 0.0, block_start = 0.0;
   double cpu_prev = 0.0, wall_prev = 0.0;  // measured-phase seconds of earlier sessions
   std::vector<double> pressure;            // VirialPressure::save()
+  double next_corr = 0.0, next_gr = 0.0;   // next sampling times of the observables
+  std::vector<double> corr, gr, nematic;   // their save() records
 };
 
 // A copy of the state with every body streamed to the current time and wrapped into the box.

@@ -43,6 +43,10 @@ const std::map<std::string, std::map<std::string, Kind>>& schema() {
       {"output",
        {{"log_interval", Kind::Float}, {"snapshot_interval", Kind::Float},
         {"checkpoint_interval", Kind::Float}, {"trajectory", Kind::Bool}}},
+      {"observables",
+       {{"interval", Kind::Float}, {"origin_every", Kind::Int}, {"max_lag", Kind::Float},
+        {"q", Kind::Float}, {"q_vectors", Kind::Int}, {"gr_interval", Kind::Float},
+        {"gr_bins", Kind::Int}}},
   };
   return s;
 }
@@ -203,6 +207,13 @@ Config validate(const std::string& file, const toml::table& root) {
   r.real("output", "snapshot_interval", c.snapshot_interval);
   r.real("output", "checkpoint_interval", c.checkpoint_interval);
   r.boolean("output", "trajectory", c.trajectory);
+  r.real("observables", "interval", c.obs_interval);
+  r.integer("observables", "origin_every", c.obs_origin_every);
+  r.real("observables", "max_lag", c.obs_max_lag);
+  r.real("observables", "q", c.obs_q);
+  r.integer("observables", "q_vectors", c.obs_q_vectors);
+  r.real("observables", "gr_interval", c.gr_interval);
+  r.integer("observables", "gr_bins", c.gr_bins);
 
   auto bad = [&](const char* sec, const char* key, const std::string& what) {
     r.fail(r.node(sec, key), std::string(sec) + "." + key, what);
@@ -262,6 +273,14 @@ Config validate(const std::string& file, const toml::table& root) {
   if (!(c.log_interval > 0.0)) bad("output", "log_interval", "must be positive");
   if (!(c.snapshot_interval > 0.0)) bad("output", "snapshot_interval", "must be positive");
   if (!(c.checkpoint_interval > 0.0)) bad("output", "checkpoint_interval", "must be positive");
+  if (c.obs_interval < 0.0) bad("observables", "interval", "must not be negative (0 switches it off)");
+  if (c.obs_origin_every < 1) bad("observables", "origin_every", "must be at least 1");
+  if (c.obs_interval > 0.0 && !(c.obs_max_lag >= c.obs_interval))
+    bad("observables", "max_lag", "must be at least observables.interval");
+  if (!(c.obs_q > 0.0)) bad("observables", "q", "must be positive");
+  if (c.obs_q_vectors < 1) bad("observables", "q_vectors", "must be at least 1");
+  if (c.gr_interval < 0.0) bad("observables", "gr_interval", "must not be negative (0 switches it off)");
+  if (c.gr_bins < 1 || c.gr_bins > 100000) bad("observables", "gr_bins", "must be in 1..100000");
   return c;
 }
 
@@ -316,6 +335,13 @@ std::string to_toml(const Config& c) {
                              {"snapshot_interval", c.snapshot_interval},
                              {"checkpoint_interval", c.checkpoint_interval},
                              {"trajectory", c.trajectory}}},
+      {"observables", toml::table{{"interval", c.obs_interval},
+                                  {"origin_every", int64_t(c.obs_origin_every)},
+                                  {"max_lag", c.obs_max_lag},
+                                  {"q", c.obs_q},
+                                  {"q_vectors", int64_t(c.obs_q_vectors)},
+                                  {"gr_interval", c.gr_interval},
+                                  {"gr_bins", int64_t(c.gr_bins)}}},
   };
   std::ostringstream os;
   os << "# hardbody resolved configuration (every key, defaults filled in)\n" << root << "\n";

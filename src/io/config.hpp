@@ -50,6 +50,14 @@ struct Config {
   double snapshot_interval = 10.0;
   double checkpoint_interval = 600.0;  // wall seconds
   bool trajectory = true;
+  // [observables]
+  double obs_interval = 0.1;     // sampling interval of MSD, C2, F_self (0: off)
+  std::uint64_t obs_origin_every = 10;
+  double obs_max_lag = 10.0;     // longest lag time of the correlation tables
+  double obs_q = 2.0 * kPi;      // target |q| of F_self
+  std::uint64_t obs_q_vectors = 6;
+  double gr_interval = 5.0;      // sampling interval of g(r) (0: off)
+  std::uint64_t gr_bins = 200;
 };
 
 // Reads and validates a config file; `overrides` are "section.key=value" strings (--set) whose

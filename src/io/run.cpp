@@ -16,7 +16,9 @@
 #include "io/files.hpp"
 #include "io/gsd_hoomd.hpp"
 #include "io/progress.hpp"
+#include "observers/correlations.hpp"
 #include "observers/overlap.hpp"
+#include "observers/structure.hpp"
 #include "observers/thermo.hpp"
 #include "system/init.hpp"
 #include "system/sphere_setup.hpp"
@@ -164,7 +166,28 @@ class Driver {
  public:
   Driver(const Config& cfg, const RunOptions& opt, const std::string& dir, Sim& sim,
          const DriverState& st, const ShapeSpec& shape, double sigma)
-      : cfg_(cfg), opt_(opt), dir_(dir), sim_(sim), st_(st), shape_(shape), sigma_(sigma) {}
+      : cfg_(cfg), opt_(opt), dir_(dir), sim_(sim), st_(st), shape_(shape), sigma_(sigma),
+        corr_(correlation_spec(cfg)), rdf_(rdf_spec(cfg)) {
+    if (!st_.pressure.empty()) pressure_.load(st_.pressure);
+    if (!st_.corr.empty()) corr_.load(st_.corr);
+    if (!st_.gr.empty()) rdf_.load(st_.gr);
+    if (!st_.nematic.empty()) nem_.load(st_.nematic);
+  }
+
+  static CorrelationSpec correlation_spec(const Config& c) {
+    CorrelationSpec s;
+    s.interval = c.obs_interval > 0.0 ? c.obs_interval : 1.0;
+    s.origin_every = int(c.obs_origin_every);
+    s.max_lag_samples = std::max(1, int(std::lround(c.obs_max_lag / s.interval)));
+    s.q = c.obs_q;
+    s.max_q_vectors = int(c.obs_q_vectors);
+    return s;
+  }
+  static RdfSpec rdf_spec(const Config& c) {
+    RdfSpec s;
+    s.bins = int(c.gr_bins);
+    return s;
+  }
 
   void run() {
     const double t_eq = cfg_.equilibrate_time, t_end = t_eq + cfg_.time;
@@ -196,6 +219,8 @@ class Driver {
         for (int k = 0; k < kEventTypes; ++k) st_.events0[k] = double(sim_.event_counts()[k]);
         st_.block_start = sim_.now();
         st_.next_snapshot = sim_.now();
+        st_.next_corr = sim_.now();
+        st_.next_gr = sim_.now();
         cpu_mark_ = cpu_seconds();
         wall_mark_ = progress_.wall_seconds();
       }
@@ -205,9 +230,12 @@ class Driver {
         st_.frames += 1;
         st_.next_snapshot += cfg_.snapshot_interval;
       }
+      if (st_.phase == 1) sample_observables();
       const double block_end = st_.phase == 0 ? t_eq : std::min(t_end, st_.block_start + cfg_.log_interval);
       double target = block_end;
       if (st_.phase == 1 && writer) target = std::min(target, st_.next_snapshot);
+      if (st_.phase == 1 && cfg_.obs_interval > 0.0) target = std::min(target, st_.next_corr);
+      if (st_.phase == 1 && cfg_.gr_interval > 0.0) target = std::min(target, st_.next_gr);
       bool limit = false;
       for (;;) {
         const StepInfo s = sim_.step(target);
@@ -226,6 +254,7 @@ class Driver {
         const double kT = temperature();
         pressure_.close_block(sim_.now() - st_.block_start, kT, n);
         st_.block_start = sim_.now();
+        nem_.sample(sim_.now(), sim_.state(), sim_.box());  // orientations: no streaming needed for spheres
         log.row(sim_.now() - t_eq, double(sim_.collisions()) - st_.coll0, pressure_.last_Z(),
                 pressure_.Z().mean, kT, (energy() - st_.e0) / st_.e0,
                 pressure_.collision_rate().mean);
@@ -254,6 +283,9 @@ class Driver {
   // Checkpoint of the current moment (also used on failures).
   void write_checkpoint() {
     st_.pressure = pressure_.save();
+    st_.corr = corr_.save();
+    st_.gr = rdf_.save();
+    st_.nematic = nem_.save();
     if (st_.phase == 1) {
       const double c = cpu_seconds(), w = progress_.wall_seconds();
       st_.cpu_prev += c - cpu_mark_;
@@ -265,11 +297,23 @@ class Driver {
     last_checkpoint_ = progress_.wall_seconds();
   }
 
-  void restore_pressure(const std::vector<double>& p) {
-    if (!p.empty()) pressure_.load(p);
+ private:
+  // Samples due at the current time (the loop stops exactly at each sampling time).
+  void sample_observables() {
+    const bool corr = cfg_.obs_interval > 0.0 && sim_.now() >= st_.next_corr;
+    const bool gr = cfg_.gr_interval > 0.0 && sim_.now() >= st_.next_gr;
+    if (!corr && !gr) return;
+    const State s = synchronized_state(sim_);
+    if (corr) {
+      corr_.sample(sim_.now(), s, sim_.box());
+      st_.next_corr += cfg_.obs_interval;
+    }
+    if (gr) {
+      rdf_.sample(sim_.now(), s, sim_.box());
+      st_.next_gr += cfg_.gr_interval;
+    }
   }
 
- private:
   void housekeeping() {
     if (const int sig = g_signal.load()) throw Interrupted(sig);
     if (progress_.wall_seconds() - last_checkpoint_ >= cfg_.checkpoint_interval) write_checkpoint();
@@ -326,6 +370,16 @@ class Driver {
     j["neighbors"] = cfg_.neighbors_method;
     j["equilibrate_time"] = cfg_.equilibrate_time;
     j["trajectory_frames"] = st_.frames;
+    if (cfg_.obs_interval > 0.0) {
+      const auto fit = corr_.diffusion();
+      if (fit.points > 0) {
+        j["diffusion_coefficient"] = fit.D;
+        j["diffusion_fit_range"] = {fit.t_from, fit.t_to};
+      }
+      write_file_atomic(dir_ + "/correlations.tsv", corr_.to_tsv());
+    }
+    if (cfg_.gr_interval > 0.0) write_file_atomic(dir_ + "/gr.tsv", rdf_.to_tsv());
+    write_file_atomic(dir_ + "/nematic.tsv", nem_.to_tsv());
     log.commit();
     write_file_atomic(dir_ + "/summary.json", j.dump(2) + "\n");
     if (!opt_.quiet)
@@ -345,6 +399,9 @@ class Driver {
   ShapeSpec shape_;
   double sigma_;
   VirialPressure pressure_;
+  TimeCorrelations corr_;
+  RadialDistribution rdf_;
+  NematicOrder nem_;
   Progress progress_;
   double cpu_mark_ = 0.0, wall_mark_ = 0.0, last_checkpoint_ = 0.0;
 };
@@ -353,7 +410,6 @@ template <class Sim>
 void drive(const Config& cfg, const RunOptions& opt, const std::string& dir, Sim& sim,
            const DriverState& st, double sigma) {
   Driver<Sim> d(cfg, opt, dir, sim, st, cfg.shape, sigma);
-  d.restore_pressure(st.pressure);
   try {
     d.run();
   } catch (const Interrupted& e) {

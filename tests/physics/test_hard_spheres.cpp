@@ -79,3 +79,18 @@ TEST(HardSpherePhysics, DenseCrystalRunsWithoutOverlaps) {
   EXPECT_GT(s["collisions"].get<std::uint64_t>(), 100000u);
   EXPECT_LE(std::abs(s["energy_drift"].get<double>()), 1e-12);
 }
+
+// Dynamics (Lue 2005 via ../shared/reference/hs_dynamics_reference_points.csv): hard spheres
+// at rho = 0.5 (phi = 0.2618), N = 1372: mean free time 0.13031 (1 %) and D = 0.247 (8 %).
+TEST(HardSpherePhysics, MeanFreeTimeAndDiffusionMatchLue2005) {
+  const double phi = M_PI / 6.0 * 0.5;
+  std::string cfg = sphere_config(1372, phi, 10.0, 200.0, 21, 1.0);
+  cfg += "[observables]\ninterval = 0.1\norigin_every = 10\nmax_lag = 10.0\ngr_interval = 0.0\n";
+  const auto s = run_config("dynamics", cfg);
+  const double mft = 1.0 / s["collision_rate"].get<double>();
+  const double D = s["diffusion_coefficient"];
+  std::printf("rho=0.5: mean free time %.5f (ref 0.13031), D %.4f (ref 0.247)\n", mft, D);
+  EXPECT_LE(std::abs(mft / 0.13031 - 1.0), 0.01);
+  EXPECT_LE(std::abs(D / 0.247 - 1.0), 0.08);
+  EXPECT_EQ(s["overlaps"].get<int>(), 0);
+}
