@@ -1,0 +1,225 @@
+// Escape time of a freely moving convex body from a fixed oriented box (the NNL rebuild time,
+// paper section 3.3 "Prediction of the collision time" of an ellipsoid with its parallelepiped).
+//
+// Input: a shape with a closed-form support function h, the body's state at t_state, the box,
+// the window [t_start, t_max] and two lengths: `margin` (the box is shrunk by it on every face,
+// the paper's trick, see below) and `eps` (the grazing step, the paper's epsilon_d^nnl).
+// Output: the first time in the window at which the body touches the SHRUNKEN box, the face,
+// and a status: escapes (time found), inside (no contact in the window) or outside (already
+// through a face of the shrunken box at t_start: time = t_start).
+//
+// Per face f (outward unit normal n, plane n.x = c, faces as in geometry/obb.hpp) the signed
+// distance of the body is closed form (DESIGN.md, geometry/plane.hpp):
+//     d_f(t) = c - margin - n.r(t) - h(R(t)^T n),
+// with r(t) = r + v (t - t_state) and R(t) = exp(skew(w) (t - t_state)) R (free_flight.hpp).
+// Its rate: d/dt R^T n = -R^T (w x n), and grad h = p (the support point), so
+//     d_f'(t) = -n.v + (R p).(w x n),   |d_f'| <= K_f = |n.v| + |w x n| L,
+// L the bounding radius (|R p| <= L). This is the paper's Eq. distplover, tightened by using
+// only the part of w normal to the face.
+//
+// Algorithm (conservative advancement, rigorous except for the grazing search of step 3):
+//  1. From t with distances d_f > 0 no face can be reached before t + d_f / K_f. Step
+//     dt = min_f max(d_f, eps) / K_f (at most eps / K_f per step near a face, so the number of
+//     steps is bounded by (t_max - t_start) max_f K_f / eps plus a logarithmic far part).
+//  2. A face with d_f < 0 at the end of a step brackets a root on that step.
+//  3. A face with d0 + d1 <= K_f dt (the only case in which the Lipschitz bound allows a hidden
+//     dip below zero; then both ends are within eps) whose rate goes from - to + inside the step
+//     is searched for its minimum by Brent's minimiser, stopping at the first negative value,
+//     which brackets the root on [t0, t_min]. The step is shorter than eps / K_f, so d_f is
+//     unimodal there in all but pathological cases.
+//  4. Every bracket of the step is shrunk on the sign of d_f (Illinois + bisection) to a width
+//     of a few ulps of t and its left end (d_f >= 0) is kept; the earliest face wins. The time
+//     returned is therefore never later than the first contact with the shrunken box.
+// Shrunken box: the search runs against the box shrunk by `margin`. A dip that step 3 missed
+// is at most (d0 + d1 - K_f dt) / 2 >= -eps / 2 deep (Lipschitz), so with margin >= eps / 2 the
+// body is still inside the real box, and every returned time precedes the first contact with
+// the real box by construction (d_real = d_f + margin > 0 up to it). Callers (the NNL) rebuild
+// at the returned time; bodies are therefore never outside their real box.
+#pragma once
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "geometry/obb.hpp"
+#include "math/brent.hpp"
+#include "math/types.hpp"
+#include "motion/free_flight.hpp"
+#include "shapes/shape.hpp"
+
+namespace hb {
+
+enum class EscapeStatus { escapes, inside, outside };
+
+template <SupportShape S>
+struct EscapeInput {
+  const S& shape;
+  BodyState body;         // at time t_state
+  double t_state = 0.0;
+  double t_start = 0.0;   // search window [t_start, t_max] (absolute times)
+  double t_max = kInf;
+  Obb box;
+  double margin = 0.0;    // the box is shrunk by this on every face (>= eps / 2, see above)
+  double eps = 1e-3;      // grazing step length (the paper's epsilon_d^nnl), << body size
+};
+
+struct EscapeOptions {
+  long max_steps = 50'000'000;  // guard; exceeding it stops the search (status inside, time =
+                                // the last safe time, `truncated` set)
+  int brent_max_evals = 60;
+};
+
+struct EscapeResult {
+  EscapeStatus status = EscapeStatus::inside;
+  double time = kInf;        // escapes/outside: the time; inside: kInf (or last safe time if truncated)
+  int face = -1;             // 0..5 (obb.hpp numbering)
+  double distance = kInf;    // d_f at `time` (>= 0 for escapes, < 0 for outside)
+  long steps = 0;
+  int grazing_searches = 0;
+  bool truncated = false;
+};
+
+// The six closed-form face distances of a body in free flight (shrunken box), and their rates.
+template <SupportShape S>
+struct BoxDistance {
+  const S& shape;
+  BodyState st;          // position relative to the box centre
+  double t_state;
+  Mat3 axes;
+  Vec3 lim;              // half - margin
+  double L;
+
+  BoxDistance(const S& s, const BodyState& b, double ts, const Obb& box, double margin)
+      : shape(s), st(b), t_state(ts), axes(box.axes), lim(box.half.array() - margin),
+        L(s.bounding_radius()) {
+    st.r = b.r - box.centre;
+  }
+  // d_f at t for every face; with rates when dd is non-null.
+  void at(double t, std::array<double, 6>& d, std::array<double, 6>* dd = nullptr) const {
+    const double tau = t - t_state;
+    const Vec3 r = st.r + st.v * tau;
+    const Mat3 R = rotation_at(st, tau);
+    const Vec3 x = axes.transpose() * r;        // centre along the box axes
+    const Mat3 Rn = R.transpose() * axes;       // column k: box axis k in the body frame
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 nb = Rn.col(k);
+      d[2 * k] = lim[k] + x[k] - shape.support(-nb);
+      d[2 * k + 1] = lim[k] - x[k] - shape.support(nb);
+      if (dd) {
+        const Vec3 u = axes.col(k);
+        const Vec3 wxu = st.w.cross(u);
+        const double vn = st.v.dot(u);
+        const Vec3 pm = R * shape.support_point(-nb), pp = R * shape.support_point(nb);
+        (*dd)[2 * k] = vn - pm.dot(wxu);
+        (*dd)[2 * k + 1] = -vn + pp.dot(wxu);
+      }
+    }
+  }
+  double face_at(int f, double t) const {
+    const double tau = t - t_state;
+    const int k = f >> 1;
+    const Vec3 u = (f & 1) ? Vec3(axes.col(k)) : Vec3(-axes.col(k));
+    const Vec3 r = st.r + st.v * tau;
+    const Mat3 R = rotation_at(st, tau);
+    return lim[k] - u.dot(r) - shape.support(R.transpose() * u);
+  }
+  double face_rate(int f, double t) const {
+    const double tau = t - t_state;
+    const int k = f >> 1;
+    const Vec3 u = (f & 1) ? Vec3(axes.col(k)) : Vec3(-axes.col(k));
+    const Mat3 R = rotation_at(st, tau);
+    return -u.dot(st.v) + (R * shape.support_point(R.transpose() * u)).dot(st.w.cross(u));
+  }
+  // |d_f'| <= K_f
+  double rate_bound(int f) const {
+    const Vec3 u = axes.col(f >> 1);
+    return std::abs(st.v.dot(u)) + st.w.cross(u).norm() * L;
+  }
+};
+
+template <SupportShape S>
+EscapeResult escape_time(const EscapeInput<S>& in, const EscapeOptions& o = {}) {
+  EscapeResult out;
+  const BoxDistance<S> D(in.shape, in.body, in.t_state, in.box, in.margin);
+  std::array<double, 6> K, d0, d1;
+  double kmax = 0.0;
+  for (int f = 0; f < 6; ++f) kmax = std::max(kmax, K[f] = D.rate_bound(f));
+  double t = in.t_start;
+  D.at(t, d0);
+  {
+    int fmin = 0;
+    for (int f = 1; f < 6; ++f)
+      if (d0[f] < d0[fmin]) fmin = f;
+    if (d0[fmin] < 0.0) {
+      out.status = EscapeStatus::outside;
+      out.time = t;
+      out.face = fmin;
+      out.distance = d0[fmin];
+      return out;
+    }
+  }
+  if (kmax == 0.0 || !(t < in.t_max)) return out;  // at rest (or empty window): never leaves
+  const double eps = std::max(in.eps, 1e-300);
+  auto ttol = [](double x) { return 8.0 * 2.220446049250313e-16 * std::max(1.0, std::abs(x)); };
+
+  while (t < in.t_max) {
+    if (++out.steps > o.max_steps) {
+      out.truncated = true;
+      out.time = t;
+      return out;
+    }
+    double dt = kInf;
+    for (int f = 0; f < 6; ++f)
+      if (K[f] > 0.0) dt = std::min(dt, std::max(d0[f], eps) / K[f]);
+    const double t1 = std::min(t + dt, in.t_max);
+    const double h = t1 - t;
+    D.at(t1, d1);
+    // brackets [t, hi_f] of this step, per face
+    double best_t = kInf;
+    int best_f = -1;
+    double best_d = 0.0;
+    std::array<double, 6> dd0{}, dd1{};
+    bool rates = false;
+    for (int f = 0; f < 6; ++f) {
+      double hi = kInf, dhi = 0.0;
+      if (d1[f] <= 0.0) {  // (a step of exactly d / K can land on the root: d1 = 0)
+        hi = t1, dhi = d1[f];
+      } else if (d0[f] + d1[f] <= K[f] * h) {  // a hidden dip is possible: grazing search
+        if (!rates) {
+          D.at(t, d0, &dd0);
+          D.at(t1, d1, &dd1);
+          rates = true;
+        }
+        if (dd0[f] < 0.0 && dd1[f] > 0.0) {
+          ++out.grazing_searches;
+          auto fn = [&](double x) { return D.face_at(f, x); };
+          const double x0 = t + h * d0[f] / (d0[f] + d1[f]);
+          const double xs = (x0 > t && x0 < t1) ? x0 : 0.5 * (t + t1);
+          const BrentMin m = brent_minimize(fn, t, t1, xs, ttol(t1), o.brent_max_evals,
+                                            [](double v) { return v < 0.0; });
+          if (m.fx < 0.0) hi = m.x, dhi = m.fx;
+        }
+      }
+      if (hi == kInf || !(t < best_t)) continue;
+      if (d0[f] == 0.0) {  // touching at the start of the step (only possible at t_start)
+        best_t = t, best_f = f, best_d = 0.0;
+        continue;
+      }
+      // shrink [t, hi] on the sign of d_f, keep the left end (d_f > 0)
+      const RootBracket br = bracket_root([&](double x) { return D.face_at(f, x); }, t, d0[f],
+                                          hi, dhi, ttol(hi), 200);
+      if (br.lo < best_t) best_t = br.lo, best_f = f, best_d = br.flo;
+    }
+    if (best_f >= 0) {
+      out.status = EscapeStatus::escapes;
+      out.time = best_t;
+      out.face = best_f;
+      out.distance = best_d;
+      return out;
+    }
+    t = t1;
+    d0 = d1;
+  }
+  return out;
+}
+
+}  // namespace hb
