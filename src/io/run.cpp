@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <atomic>
+#include <functional>
 #include <csignal>
 #include <ctime>
 #include <filesystem>
@@ -21,6 +22,7 @@
 #include "observers/structure.hpp"
 #include "observers/thermo.hpp"
 #include "system/init.hpp"
+#include "system/rigid_setup.hpp"
 #include "system/sphere_setup.hpp"
 
 namespace hb {
@@ -154,6 +156,12 @@ void truncate_trajectory(const std::string& path, std::uint64_t frames) {
   std::filesystem::rename(tmp, path);
 }
 
+// What the driver needs to know about the bodies beyond the event loop.
+struct SystemOps {
+  std::function<double(const State&)> kinetic;  // total kinetic energy (translation + rotation)
+  std::function<OverlapReport(const State&, const Box&)> overlaps;  // independent check, synced state
+};
+
 class Interrupted : public std::runtime_error {
  public:
   explicit Interrupted(int sig) : std::runtime_error("interrupted"), signal(sig) {}
@@ -165,8 +173,8 @@ template <class Sim>
 class Driver {
  public:
   Driver(const Config& cfg, const RunOptions& opt, const std::string& dir, Sim& sim,
-         const DriverState& st, const ShapeSpec& shape, double sigma)
-      : cfg_(cfg), opt_(opt), dir_(dir), sim_(sim), st_(st), shape_(shape), sigma_(sigma),
+         const DriverState& st, const ShapeSpec& shape, const SystemOps& ops)
+      : cfg_(cfg), opt_(opt), dir_(dir), sim_(sim), st_(st), shape_(shape), ops_(ops),
         corr_(correlation_spec(cfg)), rdf_(rdf_spec(cfg)) {
     if (!st_.pressure.empty()) pressure_.load(st_.pressure);
     if (!st_.corr.empty()) corr_.load(st_.corr);
@@ -254,16 +262,16 @@ class Driver {
         const double kT = temperature();
         pressure_.close_block(sim_.now() - st_.block_start, kT, n);
         st_.block_start = sim_.now();
-        nem_.sample(sim_.now(), sim_.state(), sim_.box());  // orientations: no streaming needed for spheres
+        nem_.sample(sim_.now(), synchronized_state(sim_), sim_.box());
         log.row(sim_.now() - t_eq, double(sim_.collisions()) - st_.coll0, pressure_.last_Z(),
                 pressure_.Z().mean, kT, (energy() - st_.e0) / st_.e0,
                 pressure_.collision_rate().mean);
         st_.log_rows += 1;
         if (sim_.now() >= t_end || limit) {
-          st_.phase = 2;
           st_.cpu_prev = measured_cpu();
           st_.wall_prev += progress_.wall_seconds() - wall_mark_;
           wall_mark_ = progress_.wall_seconds();
+          st_.phase = 2;
         }
       }
       housekeeping();
@@ -318,19 +326,20 @@ class Driver {
     if (const int sig = g_signal.load()) throw Interrupted(sig);
     if (progress_.wall_seconds() - last_checkpoint_ >= cfg_.checkpoint_interval) write_checkpoint();
   }
-  double energy() const { return kinetic_energy(sim_.state(), cfg_.mass); }
+  double energy() const { return ops_.kinetic(sim_.state()); }
+  // translational temperature 2 K_trans / (3 N)
   double temperature() const {
-    return 2.0 * energy() / (3.0 * double(sim_.state().size()));
+    return 2.0 * kinetic_energy(sim_.state(), cfg_.mass) / (3.0 * double(sim_.state().size()));
   }
 
   void finish(LogTable& log) {
     const State st = synchronized_state(sim_);
     const std::uint64_t n = st.size();
-    const double e1 = kinetic_energy(st, cfg_.mass);
+    const double e1 = ops_.kinetic(st);
     const Vec3 p = total_momentum(st, cfg_.mass);
     double p_scale = 0.0;
     for (const auto& v : st.v) p_scale += cfg_.mass * v.norm();
-    const auto rep = sphere_overlaps(st.r, sim_.box(), sigma_);
+    const auto rep = ops_.overlaps(st, sim_.box());
     const std::uint64_t ncoll = sim_.collisions() - std::uint64_t(st_.coll0);
     const auto Z = pressure_.Z();
     const auto rate = pressure_.collision_rate();
@@ -352,7 +361,7 @@ class Driver {
     j["Z_blocks"] = Z.blocks;
     j["collision_rate"] = rate.mean;
     j["collision_rate_error"] = rate.error;
-    j["temperature"] = 2.0 * e1 / (3.0 * double(n));
+    j["temperature"] = 2.0 * kinetic_energy(st, cfg_.mass) / (3.0 * double(n));
     j["energy_drift"] = (e1 - st_.e0) / st_.e0;
     j["total_momentum"] = {p.x(), p.y(), p.z()};
     j["momentum_drift"] = p.norm() / p_scale;
@@ -366,6 +375,22 @@ class Driver {
     ev["stale"] = double(sim_.stale_events()) - st_.stale0;
     j["events"] = ev;
     j["solver_fallbacks"] = 0;
+    if constexpr (requires { sim_.model().stats; }) {
+      const SolverStats& ss = sim_.model().stats;
+      j["solver_fallbacks"] = ss.fallbacks + ss.distance_fallbacks + ss.collision_distance_fallbacks;
+      const double np = double(std::max<std::uint64_t>(ss.predictions, 1));
+      j["solver"] = {{"contact_predictions", ss.predictions},
+                     {"predictions_per_collision", double(ss.predictions) / double(std::max<std::uint64_t>(ncoll, 1))},
+                     {"distance_evals_per_prediction", double(ss.distance_evals) / np},
+                     {"distance_nr_iterations_per_eval",
+                      double(ss.distance_nr_iterations) / double(std::max<std::uint64_t>(ss.distance_evals, 1))},
+                     {"contact_nr_iterations", ss.contact_nr_iterations},
+                     {"grazing_searches", ss.grazing_searches},
+                     {"contact_fallbacks", ss.fallbacks},
+                     {"distance_fallbacks", ss.distance_fallbacks},
+                     {"collision_distance_fallbacks", ss.collision_distance_fallbacks},
+                     {"note", "counts cover the whole run, equilibration included"}};
+    }
     j["seed"] = cfg_.seed;
     j["neighbors"] = cfg_.neighbors_method;
     j["equilibrate_time"] = cfg_.equilibrate_time;
@@ -397,7 +422,7 @@ class Driver {
   Sim& sim_;
   DriverState st_;
   ShapeSpec shape_;
-  double sigma_;
+  SystemOps ops_;
   VirialPressure pressure_;
   TimeCorrelations corr_;
   RadialDistribution rdf_;
@@ -408,8 +433,8 @@ class Driver {
 
 template <class Sim>
 void drive(const Config& cfg, const RunOptions& opt, const std::string& dir, Sim& sim,
-           const DriverState& st, double sigma) {
-  Driver<Sim> d(cfg, opt, dir, sim, st, cfg.shape, sigma);
+           const DriverState& st, const SystemOps& ops) {
+  Driver<Sim> d(cfg, opt, dir, sim, st, cfg.shape, ops);
   try {
     d.run();
   } catch (const Interrupted& e) {
@@ -436,53 +461,104 @@ void drive(const Config& cfg, const RunOptions& opt, const std::string& dir, Sim
   }
 }
 
-template <class Sim>
+// Starts a new run (make_sim builds the initial system) or resumes from the checkpoint
+// (make_model and nb rebuild the model and the neighbour method around the restored state).
+template <class Sim, class MakeSim, class MakeModel>
 void start_or_resume(const Config& cfg, const RunOptions& opt, const std::string& dir,
-                     const SphereSystemSpec& spec, Sim (*make)(const SphereSystemSpec&),
-                     typename Sim::neighbors_type nb) {
+                     MakeSim make_sim, MakeModel make_model, typename Sim::neighbors_type nb,
+                     const SystemOps& ops) {
   const SignalGuard guard;
   if (opt.resume) {
     const std::string ck = dir + "/checkpoint.gsd";
     if (!file_exists(ck)) throw InputError(fmt::format("{}: no checkpoint to resume from", ck));
     auto r = read_checkpoint<typename Sim::neighbors_type>(ck, cfg);
     nb.restore(r.box, r.state, r.neighbors);
-    Sim sim(r.box, std::move(r.state), HardSpheres{spec.sigma, spec.mass}, std::move(nb), r.loop);
-    drive(cfg, opt, dir, sim, r.driver, spec.sigma);
+    Sim sim(r.box, std::move(r.state), make_model(), std::move(nb), r.loop);
+    drive(cfg, opt, dir, sim, r.driver, ops);
     return;
   }
-  Sim sim = make(spec);
+  Sim sim = make_sim();
   {
-    const auto rep = sphere_overlaps(sim.state().r, sim.box(), spec.sigma);
+    const auto rep = ops.overlaps(sim.state(), sim.box());
     if (rep.overlaps > 0)
       throw InputError(fmt::format("{}: the initial configuration has {} overlapping pairs",
                                    cfg.source, rep.overlaps));
   }
   make_directories(dir);
   write_file_atomic(dir + "/config.resolved.toml", to_toml(cfg));
-  drive(cfg, opt, dir, sim, DriverState{}, spec.sigma);
+  drive(cfg, opt, dir, sim, DriverState{}, ops);
+}
+
+RigidSystemSpec plan_ellipsoids(const Config& c) {
+  RigidSystemSpec p;
+  p.n = c.particles;
+  p.phi = c.packing_fraction;
+  p.semi_axes = c.shape.semi_axes;
+  p.mass = c.mass;
+  p.inertia = c.shape.inertia;
+  p.kT = c.temperature;
+  p.seed = c.seed;
+  p.eps_d = c.eps_d;
+  const StretchedLattice lat = stretched_lattice(c.particles, c.shape.semi_axes);
+  if (c.packing_fraction > lat.phi_max * (1.0 - 1e-12))
+    throw ConfigError(fmt::format(
+        "{}: key 'system.packing_fraction': {} is too dense for the lattice start with {} "
+        "particles (at most {:.4f})", c.source, c.packing_fraction, c.particles, lat.phi_max));
+  const double a0 = std::cbrt(double(c.particles) * (4.0 / 3.0 * kPi) /
+                              (c.packing_fraction * lat.m[0] * lat.m[1] * lat.m[2]));
+  const Vec3 L(c.shape.semi_axes.x() * a0 * lat.m[0], c.shape.semi_axes.y() * a0 * lat.m[1],
+               c.shape.semi_axes.z() * a0 * lat.m[2]);
+  const double range = 2.0 * c.shape.semi_axes.maxCoeff();
+  if (L.minCoeff() < 2.0 * range)
+    throw ConfigError(fmt::format(
+        "{}: key 'system.particles': {} particles at packing fraction {} give a box side of "
+        "{:.3g}, less than two body lengths ({:.3g}); use more particles",
+        c.source, c.particles, c.packing_fraction, L.minCoeff(), 2.0 * range));
+  return p;
 }
 
 }  // namespace
 
 void run_simulation(const RunOptions& opt) {
   const Config cfg = load_config(opt.config_path, opt.overrides);
-  if (cfg.shape.type != "sphere")
-    throw InputError(fmt::format(
-        "{}: key 'shape.type': '{}' bodies are not yet supported by `hardbody run` (only "
-        "spheres; `hardbody distance` and `contact-time` take any shape)",
-        cfg.source, cfg.shape.type));
-  // Everything is checked before any file is written.
-  const SphereSystemSpec spec = plan_spheres(cfg);
   const std::string dir = opt.out_dir.empty() ? default_out_dir(opt.config_path) : opt.out_dir;
   try {
-    if (spec.shell > 0.0)
-      start_or_resume<SphereListSim>(cfg, opt, dir, spec, &make_hard_sphere_list_simulation,
-                                     ShellNeighbors(spec.sigma, spec.shell));
-    else
-      start_or_resume<SphereCellSim>(cfg, opt, dir, spec, &make_hard_sphere_cell_simulation,
-                                     CellNeighbors(spec.sigma));
+    // Everything is checked (plan_*) before any file is written.
+    if (cfg.shape.type == "sphere") {
+      const SphereSystemSpec spec = plan_spheres(cfg);
+      const SystemOps ops{[m = spec.mass](const State& s) { return kinetic_energy(s, m); },
+                          [sigma = spec.sigma](const State& s, const Box& b) {
+                            return sphere_overlaps(s.r, b, sigma);
+                          }};
+      auto model = [&] { return HardSpheres{spec.sigma, spec.mass}; };
+      if (spec.shell > 0.0)
+        start_or_resume<SphereListSim>(cfg, opt, dir, [&] { return make_hard_sphere_list_simulation(spec); },
+                                       model, ShellNeighbors(spec.sigma, spec.shell), ops);
+      else
+        start_or_resume<SphereCellSim>(cfg, opt, dir, [&] { return make_hard_sphere_cell_simulation(spec); },
+                                       model, CellNeighbors(spec.sigma), ops);
+    } else if (cfg.shape.type == "ellipsoid") {
+      const RigidSystemSpec spec = plan_ellipsoids(cfg);
+      const auto proto = ellipsoid_model(spec);
+      const SystemOps ops{[proto](const State& s) { return proto.kinetic_energy(s); },
+                          [axes = spec.semi_axes](const State& s, const Box& b) {
+                            return ellipsoid_overlaps(s.r, s.q, b, axes);
+                          }};
+      if (cfg.neighbors_method == "nnl")
+        throw ConfigError(fmt::format(
+            "{}: key 'neighbors.method': \"nnl\" for ellipsoids is not available yet; use \"cells\"",
+            cfg.source));
+      start_or_resume<EllipsoidCellSim>(cfg, opt, dir, [&] { return make_ellipsoid_cell_simulation(spec); },
+                                        [&] { return ellipsoid_model(spec); },
+                                        CellNeighbors(proto.interaction_range()), ops);
+    } else {
+      throw ConfigError(fmt::format("{}: key 'shape.type': '{}' bodies are not yet supported by "
+                                    "`hardbody run`", cfg.source, cfg.shape.type));
+    }
   } catch (const std::filesystem::filesystem_error& e) {
     throw InputError(e.what());
+  } catch (const std::invalid_argument& e) {
+    throw InputError(fmt::format("{}: {}", cfg.source, e.what()));
   }
 }
 

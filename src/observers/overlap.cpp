@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "geometry/perram_wertheim.hpp"
+
 namespace hb {
 
 namespace {
@@ -20,6 +22,66 @@ OverlapReport sphere_overlaps_brute(const std::vector<Vec3>& r, const Box& box, 
   OverlapReport rep;
   for (std::size_t i = 0; i < r.size(); ++i)
     for (std::size_t j = i + 1; j < r.size(); ++j) check_pair(r[i], r[j], box, sigma, tol, rep);
+  return rep;
+}
+
+namespace {
+// Calls fn(i, j) for every pair i < j whose minimum-image centre distance is below `range`.
+void for_close_pairs(const std::vector<Vec3>& r, const Box& box, double range,
+                     const std::function<void(std::uint32_t, std::uint32_t, const Vec3&)>& fn) {
+  int nc[3];
+  bool brute = false;
+  for (int k = 0; k < 3; ++k) {
+    nc[k] = static_cast<int>(std::floor(box.L[k] / range));
+    if (nc[k] < 3) brute = true;
+  }
+  const double r2 = range * range;
+  if (brute) {
+    for (std::uint32_t i = 0; i < r.size(); ++i)
+      for (std::uint32_t j = i + 1; j < r.size(); ++j) {
+        const Vec3 d = box.minimum_image(r[j] - r[i]);
+        if (d.squaredNorm() < r2) fn(i, j, d);
+      }
+    return;
+  }
+  std::vector<std::vector<std::uint32_t>> cell(std::size_t(nc[0]) * nc[1] * nc[2]);
+  std::vector<std::array<int, 3>> coord(r.size());
+  for (std::uint32_t i = 0; i < r.size(); ++i) {
+    Vec3 p = r[i];
+    box.wrap(p);
+    for (int k = 0; k < 3; ++k) {
+      const int c = static_cast<int>(std::floor(p[k] / box.L[k] * nc[k]));
+      coord[i][k] = c < 0 ? 0 : (c >= nc[k] ? nc[k] - 1 : c);
+    }
+    cell[(std::size_t(coord[i][2]) * nc[1] + coord[i][1]) * nc[0] + coord[i][0]].push_back(i);
+  }
+  for (std::uint32_t i = 0; i < r.size(); ++i)
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int x = (coord[i][0] + dx + nc[0]) % nc[0];
+          const int y = (coord[i][1] + dy + nc[1]) % nc[1];
+          const int z = (coord[i][2] + dz + nc[2]) % nc[2];
+          for (std::uint32_t j : cell[(std::size_t(z) * nc[1] + y) * nc[0] + x]) {
+            if (j <= i) continue;
+            const Vec3 d = box.minimum_image(r[j] - r[i]);
+            if (d.squaredNorm() < r2) fn(i, j, d);
+          }
+        }
+}
+}  // namespace
+
+OverlapReport ellipsoid_overlaps(const std::vector<Vec3>& r, const std::vector<Quat>& q,
+                                 const Box& box, const Vec3& semi_axes, double tol) {
+  OverlapReport rep;
+  for_close_pairs(r, box, 2.0 * semi_axes.maxCoeff(), [&](std::uint32_t i, std::uint32_t j, const Vec3& d) {
+    const EllipsoidPose A{semi_axes, r[i], q[i]}, B{semi_axes, Vec3(r[i] + d), q[j]};
+    const PerramWertheim pw = perram_wertheim(A, B, d, tol);
+    ++rep.pairs_checked;
+    const double gap = d.norm() * (1.0 - 1.0 / std::sqrt(pw.F));
+    if (gap < rep.min_distance) rep.min_distance = gap;
+    if (pw.overlap) ++rep.overlaps;
+  });
   return rep;
 }
 

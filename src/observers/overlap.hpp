@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "math/types.hpp"
+#include <functional>
 #include "system/box.hpp"
 
 namespace hb {
@@ -24,5 +25,13 @@ OverlapReport sphere_overlaps_grid(const std::vector<Vec3>& r, const Box& box, d
 // Brute force up to 20000 bodies, grid beyond.
 OverlapReport sphere_overlaps(const std::vector<Vec3>& r, const Box& box, double sigma,
                               double tol = 1e-10);
+
+// Ellipsoids (all with the same semi-axes, orientations body -> lab): the Perram–Wertheim
+// contact function F (geometry/perram_wertheim, independent of the distance solver) for every
+// pair whose centres are closer than the bounding diameter; overlap when F < 1 - tol.
+// min_distance is the smallest centre-line gap |r_AB| (1 - 1/sqrt(F)): zero at contact,
+// negative for overlap. Candidate pairs come from a fresh grid (brute force for small boxes).
+OverlapReport ellipsoid_overlaps(const std::vector<Vec3>& r, const std::vector<Quat>& q,
+                                 const Box& box, const Vec3& semi_axes, double tol = 1e-10);
 
 }  // namespace hb

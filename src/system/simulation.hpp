@@ -3,9 +3,11 @@
 //
 // `Model` supplies the physics of a pair:
 //   void contact_times(const State&, const Box&, i, const uint32_t* js, const Vec3* shifts,
-//                      size_t n, double now, double* out)
+//                      size_t n, double now, double horizon, double* out)
 //       times from now (or +inf) of body i against bodies js; body j is placed at r_j + shift
-//       when shifts is non-null, else at its minimum image (Box::near_image)
+//       when shifts is non-null, else at its minimum image (Box::near_image). Contacts after
+//       the absolute time `horizon` (body i's next neighbour event) may be reported as +inf
+//       by models with kWindowed = true; the loop then re-predicts in full at that event.
 //   CollisionRecord collide(State&, const Box&, i, j, double now)     // both bodies at `now`
 //   double interaction_range() const                                  // max centre distance at contact
 // `Neighbors` (CellNeighbors, ShellNeighbors) supplies the candidates of a body and its own
@@ -131,7 +133,7 @@ class Simulation {
     state_.advance_to(i, now_);
     cand_.clear();
     shift_.clear();
-    const bool partial = nb_.handle(i, ev, state_, box_, collect());
+    const bool partial = nb_.handle(i, ev, state_, box_, collect()) && !windowed();
     // The trajectory is unchanged: if the remembered best collision is still valid, only the
     // new candidates need predicting.
     const Event& b = best_[i];
@@ -151,6 +153,10 @@ class Simulation {
   }
 
  private:
+  static constexpr bool windowed() {
+    if constexpr (requires { Model::kWindowed; }) return Model::kWindowed;
+    else return false;
+  }
   auto collect() {
     return [this](std::uint32_t j, const Vec3& shift) {
       cand_.push_back(j);
@@ -158,11 +164,11 @@ class Simulation {
     };
   }
   // Predict body i against the candidates in cand_ and keep the earliest in `best`.
-  void consider(std::uint32_t i, Event& best) {
+  void consider(std::uint32_t i, Event& best, double horizon = kInf) {
     const std::size_t n = cand_.size();
     if (times_.size() < n) times_.resize(2 * n);
     model_.contact_times(state_, box_, i, cand_.data(),
-                         nb_.needs_minimum_image() ? nullptr : shift_.data(), n, now_,
+                         nb_.needs_minimum_image() ? nullptr : shift_.data(), n, now_, horizon,
                          times_.data());
     std::size_t kbest = n;
     double tbest = best.time - now_;
@@ -185,8 +191,10 @@ class Simulation {
     cand_.clear();
     shift_.clear();
     nb_.for_each_candidate(i, box_, collect());
-    consider(i, best);
-    schedule(i, best);
+    const Event ne = nb_.next_event(i, state_, now_);
+    consider(i, best, ne.time);
+    best_[i] = best;
+    queue_.set(ne.time < best.time ? ne : best);
   }
   void schedule(std::uint32_t i, const Event& best) {
     best_[i] = best;

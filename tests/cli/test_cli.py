@@ -48,6 +48,7 @@ def test_run_writes_contract_outputs(tmp_path):
     for k in SUMMARY_KEYS:
         assert k in s, k
     assert s["particles"] == 256 and s["overlaps"] == 0 and s["collisions"] > 0
+    assert s["cpu_seconds"] > 0 and s["tau_c_us"] > 0 and s["collisions_per_second"] > 0
     assert abs(s["time"] - 2.0) < 1e-9
     rows = (out / "log.tsv").read_text().strip().splitlines()
     assert rows[0].startswith("time\t") and len(rows) == 1 + 8

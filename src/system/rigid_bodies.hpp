@@ -1,0 +1,119 @@
+// Pair model of identical hard rigid bodies of any convex shape (spherical tops) for the event
+// loop: contact times from the generic solver of contact/ (paper section 2.4) within a window
+// that ends at the body's next neighbour event, and the rigid-body impulse of collision/.
+#pragma once
+#include <fmt/format.h>
+
+#include <cstdint>
+#include <sstream>
+#include <stdexcept>
+
+#include "collision/rigid.hpp"
+#include "contact/contact_time.hpp"
+#include "geometry/distance.hpp"
+#include "system/box.hpp"
+#include "system/state.hpp"
+
+namespace hb {
+
+// Solver work and trouble, summed over a run (reported in summary.json).
+struct SolverStats {
+  std::uint64_t predictions = 0;       // contact-time solves
+  std::uint64_t distance_evals = 0;    // distance solves inside them
+  std::uint64_t distance_nr_iterations = 0;
+  std::uint64_t contact_nr_iterations = 0;
+  std::uint64_t grazing_searches = 0;
+  std::uint64_t fallbacks = 0;         // contact NR rejected, bracket shrunk instead
+  std::uint64_t distance_fallbacks = 0;
+  std::uint64_t collision_distance_fallbacks = 0;
+};
+
+// A contact-time solve that failed (every fallback exhausted): carries a reproducer in the
+// `hardbody contact-time` input format.
+class SolverFailure : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+template <Shape S>
+struct RigidBodies {
+  static constexpr bool kWindowed = true;  // predictions only up to the body's next neighbour event
+
+  S shape;
+  MassProperties mass;
+  double eps_d = 1e-5;
+  ContactOptions options{};
+  mutable SolverStats stats{};
+
+  double interaction_range() const { return 2.0 * shape.bounding_radius(); }
+
+  void contact_times(const State& s, const Box& box, std::uint32_t i, const std::uint32_t* js,
+                     const Vec3* shifts, std::size_t n, double now, double horizon,
+                     double* out) const {
+    const BodyState a = s.body(i);  // body i is at `now`
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::uint32_t j = js[k];
+      out[k] = kInf;
+      if (j == i) continue;
+      BodyState b = s.body_at(j, now);
+      b.r = shifts ? Vec3(b.r + shifts[k]) : Vec3(a.r + box.near_image(b.r - a.r));
+      ContactInput<S, S> in{shape, shape, a, b, now, now, horizon, eps_d};
+      const ContactResult r = contact_time(in, options);
+      ++stats.predictions;
+      stats.distance_evals += r.distance_evals;
+      stats.distance_nr_iterations += r.distance_nr_iterations;
+      stats.contact_nr_iterations += r.nr_iterations;
+      stats.grazing_searches += r.grazing_searches;
+      stats.fallbacks += r.fallbacks;
+      stats.distance_fallbacks += r.distance_fallbacks;
+      if (r.status == ContactStatus::failed)
+        throw SolverFailure(fmt::format("contact-time solver failed for bodies {} and {} at t = {:.17g}; "
+                                        "reproducer: {}", i, j, now, reproducer(a, b, horizon - now)));
+      if (r.status == ContactStatus::hit) out[k] = std::max(0.0, r.time - now);
+    }
+  }
+
+  CollisionRecord collide(State& s, const Box& box, std::uint32_t i, std::uint32_t j,
+                          double now) const {
+    BodyState a = s.body(i), b = s.body(j);  // both at `now`
+    const Vec3 r_ab = box.near_image(b.r - a.r);
+    const Pose pa{a.r, a.q.toRotationMatrix()};
+    const Pose pb{Vec3(a.r + r_ab), b.q.toRotationMatrix()};
+    const DistanceResult d = distance(shape, pa, shape, pb, options.distance);
+    if (d.status == DistanceStatus::failed)
+      throw SolverFailure(fmt::format("distance solver failed at the collision of {} and {}", i, j));
+    if (d.status == DistanceStatus::fallback) ++stats.collision_distance_fallbacks;
+    const Vec3 x_c = 0.5 * (d.point_a + d.point_b);
+    CollisionRecord rec = hb::collide(a, mass, b, mass, x_c, d.normal, r_ab);
+    s.v[i] = a.v, s.w[i] = a.w;
+    s.v[j] = b.v, s.w[j] = b.w;
+    rec.a = i;
+    rec.b = j;
+    return rec;
+  }
+
+  double kinetic_energy(const State& s) const {
+    double k = 0.0;
+    for (std::size_t i = 0; i < s.size(); ++i) k += hb::kinetic_energy(s.body(i), mass);
+    return k;
+  }
+
+  std::string reproducer(const BodyState& a, const BodyState& b, double t_max) const {
+    auto body = [&](const BodyState& x) {
+      return fmt::format(
+          "{{\"shape\": {}, \"position\": [{:.17g}, {:.17g}, {:.17g}], \"orientation\": [{:.17g}, "
+          "{:.17g}, {:.17g}, {:.17g}], \"velocity\": [{:.17g}, {:.17g}, {:.17g}], "
+          "\"angular_velocity\": [{:.17g}, {:.17g}, {:.17g}]}}",
+          shape_json(), x.r.x(), x.r.y(), x.r.z(), x.q.w(), x.q.x(), x.q.y(), x.q.z(), x.v.x(),
+          x.v.y(), x.v.z(), x.w.x(), x.w.y(), x.w.z());
+    };
+    return fmt::format("{{\"a\": {}, \"b\": {}, \"t_max\": {:.17g}}}", body(a), body(b), t_max);
+  }
+  std::string shape_json() const {
+    const Vec3 h = shape.half_extents();
+    return fmt::format("{{\"type\": \"ellipsoid\", \"semi_axes\": [{:.17g}, {:.17g}, {:.17g}]}}",
+                       h.x(), h.y(), h.z());
+  }
+};
+
+}  // namespace hb
