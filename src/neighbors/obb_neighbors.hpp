@@ -1,0 +1,220 @@
+// Oriented-bounding-box neighbour lists (the paper's NNL, section 3.3) as a neighbour policy of
+// the event loop (system/simulation.hpp), with per-body rebuilds (DESIGN.md).
+//
+// Each body i has a box B_i fixed at its last rebuild: centre = the body's centre then, axes =
+// the body's axes then, half-extents = the body's extents along its axes + shell (Delta_NNL).
+// Bodies i and j are partners iff B_i and B_j overlap (15-axis SAT, geometry/obb.hpp, minimum
+// image). Body i's neighbour event (Rebuild) is its escape time from B_i shrunk by a margin
+// (contact/escape_time.hpp); at the event only B_i is rebuilt around the body's current pose
+// and the lists that contain i are updated symmetrically (found through a cell list over box
+// centres with cells at least twice the box circumradius wide, so overlapping boxes sit in
+// adjacent cells). `handle` returns false: the loop predicts i against its whole new list.
+//
+// Why no collision is missed. While body i is inside B_i and body j inside B_j, the two bodies
+// lie in B_i and B_j; if the boxes are disjoint, so are the bodies: they cannot touch. Body i
+// stays inside B_i until its escape event (the escape time is never later than the first
+// contact with the shrunken, hence with the real, box), where B_i is rebuilt before i can reach
+// anything outside its old box; the same for j. So a pair that is not listed cannot touch before
+// one of them rebuilds, and at that rebuild the pair is re-tested. A listed pair is predicted by
+// the loop (with the pair model's window ending at the owner's next rebuild, RigidBodies::
+// kWindowed); a contact after that window is found when the owner re-predicts at its rebuild.
+// A new partner j of i needs no re-prediction of j: the contact of i and j is found from i's
+// side (contact times are symmetric), and j's next collision or rebuild re-predicts j in full.
+//
+// Escape search: the box is shrunk by margin = min(0.01 inscribed radius, shell / 4) and the
+// grazing step is eps = margin (paper: epsilon_d^nnl ~ 1e-2 b), so a grazing exit that the
+// search misses leaves the body inside the real box. When no exit is found within
+// 8 * circumradius / K (K the body's speed bound; a spinning body may never leave), a rebuild is
+// scheduled at the end of that window anyway (harmless: a rebuild at any time is valid).
+//
+// Positions: at its rebuild the body's stored position is wrapped into the periodic box (image
+// counter updated), so the box centres lie in [0, L); list entries are ids and the pair code
+// uses the near image (needs_minimum_image() is true). The minimum-image SAT is exact when every
+// box side L_k > 4 * circumradius (at most one image can overlap); with at least 3 cells per axis
+// this always holds.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include "contact/escape_time.hpp"
+#include "events/event.hpp"
+#include "geometry/obb.hpp"
+#include "neighbors/cell_list.hpp"
+#include "neighbors/shell_neighbors.hpp"
+#include "shapes/shape.hpp"
+#include "system/box.hpp"
+#include "system/state.hpp"
+
+namespace hb {
+
+// The boxes of every body, for checkpoints: centre, the body orientation at the rebuild (the
+// box axes are its rotation matrix, so restoring gives bit-identical axes) and half-extents.
+struct ObbSnapshot {
+  std::vector<Vec3> centre;
+  std::vector<Quat> q;
+  std::vector<Vec3> half;
+};
+
+template <SupportShape S>
+class ObbNeighbors {
+ public:
+  static constexpr EventType kEventType = EventType::Rebuild;
+
+  ObbNeighbors(const S& shape, double shell) : shape_(shape), shell_(shell) {
+    if (!(shell > 0.0)) throw std::invalid_argument("neighbour-list shell must be positive");
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 e = Vec3::Unit(k);
+      ext_[k] = std::max({shape.half_extents()[k], shape.support(e), shape.support(Vec3(-e))});
+    }
+    margin_ = std::min(0.01 * shape.inscribed_radius(), 0.25 * shell);
+    eps_ = margin_;
+    rc_ = (ext_.array() + shell_).matrix().norm();
+    kbound_l_ = shape.bounding_radius();
+  }
+
+  void init(const Box& box, State& s, double now) {
+    setup(box, s.size());
+    for (std::uint32_t i = 0; i < s.size(); ++i) {
+      s.advance_to(i, now);
+      s.image[i] += box.wrap(s.r[i]);
+      set_box(i, s.r[i], s.q[i], Vec3(ext_.array() + shell_));
+      cells_.insert(i, obb_[i].centre);
+    }
+    build_all(box);
+  }
+
+  ObbSnapshot snapshot() const {
+    ObbSnapshot sn;
+    sn.centre.resize(obb_.size());
+    sn.half.resize(obb_.size());
+    sn.q = q_;
+    for (std::size_t i = 0; i < obb_.size(); ++i) {
+      sn.centre[i] = obb_[i].centre;
+      sn.half[i] = obb_[i].half;
+    }
+    return sn;
+  }
+  void restore(const Box& box, const State& s, const ObbSnapshot& sn) {
+    const std::size_t n = s.size();
+    if (sn.centre.size() != n || sn.q.size() != n || sn.half.size() != n)
+      throw std::invalid_argument("neighbour-list snapshot does not match the number of bodies");
+    setup(box, n);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      set_box(i, sn.centre[i], sn.q[i], sn.half[i]);
+      cells_.insert(i, obb_[i].centre);
+    }
+    build_all(box);
+  }
+
+  const AdjacencyLists& lists() const { return lists_; }
+  const Obb& box_of(std::uint32_t i) const { return obb_[i]; }
+  double shell() const { return shell_; }
+  double margin() const { return margin_; }
+  double circumradius() const { return rc_; }
+  std::uint64_t rebuilds() const { return rebuilds_; }
+  std::uint64_t truncated_searches() const { return truncated_; }
+  bool needs_minimum_image() const { return true; }
+
+  template <class Fn>
+  void for_each_candidate(std::uint32_t i, const Box&, Fn&& fn) const {
+    static const Vec3 zero = Vec3::Zero();
+    for (const std::uint32_t* p = lists_.begin(i); p != lists_.end(i); ++p) fn(*p, zero);
+  }
+
+  // Escape time of body i (stored at its own time, normally `now`) from its box.
+  Event next_event(std::uint32_t i, const State& s, double now) const {
+    Event e;
+    e.owner = i;
+    const BodyState b = s.body(i);
+    const double K = b.v.norm() + b.w.norm() * kbound_l_;
+    if (K == 0.0) return e;  // at rest: never leaves
+    const double t_cap = now + 8.0 * rc_ / K;
+    EscapeInput<S> in{shape_, b, s.t[i], now, t_cap, obb_[i], margin_, eps_};
+    const EscapeResult r = escape_time(in);
+    if (r.truncated) ++truncated_;
+    e.type = kEventType;
+    switch (r.status) {
+      case EscapeStatus::escapes:
+        e.time = r.time;
+        e.partner = static_cast<std::uint32_t>(r.face);
+        break;
+      case EscapeStatus::outside:
+        e.time = now;
+        e.partner = static_cast<std::uint32_t>(r.face);
+        break;
+      case EscapeStatus::inside:
+        e.time = r.truncated ? r.time : t_cap;
+        e.partner = 6;
+        break;
+    }
+    return e;
+  }
+
+  // Rebuild body i's box around its current pose (body already streamed to the event time) and
+  // update the lists it appears in. Returns false: predict i against its whole new list.
+  template <class Fn>
+  bool handle(std::uint32_t i, const Event&, State& s, const Box& box, Fn&&) {
+    ++rebuilds_;
+    s.image[i] += box.wrap(s.r[i]);
+    set_box(i, s.r[i], s.q[i], obb_[i].half);
+    cells_.remove(i);
+    cells_.insert(i, obb_[i].centre);
+    for (const std::uint32_t* p = lists_.begin(i); p != lists_.end(i); ++p) lists_.remove(*p, i);
+    lists_.clear(i);
+    link(i, box, [i](std::uint32_t j) { return j != i; });
+    return false;
+  }
+
+  // Do the boxes of i and j overlap (j at its image given by the cell stencil, or the minimum
+  // image when the cell list cannot tell images apart)?
+  bool overlap(std::uint32_t i, std::uint32_t j, const Vec3& shift, const Box& box) const {
+    Vec3 d = obb_[j].centre + shift - obb_[i].centre;
+    if (cells_.needs_minimum_image()) d = box.minimum_image(d);
+    if (d.squaredNorm() > 4.0 * rc_ * rc_) return false;  // circumspheres apart
+    return obb_overlap(obb_[i], obb_[j], Vec3(d - (obb_[j].centre - obb_[i].centre)));
+  }
+
+ private:
+  void setup(const Box& box, std::size_t n) {
+    const double reach = 2.0 * rc_;
+    const double rho = double(n) / box.volume();
+    const double expect = rho * 4.18879 * reach * reach * reach;  // centres within 2 rc
+    lists_.init(n, static_cast<std::uint32_t>(std::min<double>(expect + 16, double(n))));
+    cells_.init(box.L, reach, n);
+    obb_.assign(n, Obb{});
+    q_.assign(n, Quat::Identity());
+  }
+  void set_box(std::uint32_t i, const Vec3& centre, const Quat& q, const Vec3& half) {
+    q_[i] = q;
+    obb_[i].centre = centre;
+    obb_[i].axes = q.toRotationMatrix();
+    obb_[i].half = half;
+  }
+  void build_all(const Box& box) {
+    for (std::uint32_t i = 0; i < obb_.size(); ++i) link(i, box, [i](std::uint32_t j) { return j > i; });
+  }
+  // List i and j both ways for every j of the cell stencil with take(j) whose box overlaps i's.
+  template <class Take>
+  void link(std::uint32_t i, const Box& box, Take take) {
+    cells_.for_each_neighbor(i, box.L, [&](std::uint32_t j, const Vec3& shift) {
+      if (take(j) && overlap(i, j, shift, box)) lists_.add(i, j), lists_.add(j, i);
+    });
+  }
+
+  S shape_;
+  double shell_;
+  Vec3 ext_ = Vec3::Ones();  // body extents along its axes (max of half_extents and support)
+  double margin_ = 0.0, eps_ = 0.0;
+  double rc_ = 0.0;          // box circumradius
+  double kbound_l_ = 0.0;    // bounding radius (speed bound of the body's points)
+  CellList cells_;           // over box centres; changes only at rebuilds
+  std::vector<Obb> obb_;
+  std::vector<Quat> q_;
+  AdjacencyLists lists_;
+  std::uint64_t rebuilds_ = 0;
+  mutable std::uint64_t truncated_ = 0;
+};
+
+}  // namespace hb
