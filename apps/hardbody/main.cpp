@@ -9,6 +9,10 @@
 
 #include "io/config.hpp"
 #include "io/convert.hpp"
+#include "io/pair_query.hpp"
+
+#include <fstream>
+#include <iostream>
 #include "io/run.hpp"
 
 int main(int argc, char** argv) {
@@ -29,6 +33,14 @@ int main(int argc, char** argv) {
   cmd_conv->add_option("--to", conv_to, "output format")->check(CLI::IsMember({"xyz"}));
   cmd_conv->add_option("-o,--output", conv_out, "output file (default: input with .xyz)");
 
+  std::string dist_file, ct_file;
+  double ct_eps = 1e-5;
+  auto* cmd_dist = app.add_subcommand("distance", "distance of body pairs (JSON lines)");
+  cmd_dist->add_option("file", dist_file, "JSON-lines input (default stdin)");
+  auto* cmd_ct = app.add_subcommand("contact-time", "first contact time of moving pairs (JSON lines)");
+  cmd_ct->add_option("file", ct_file, "JSON-lines input (default stdin)");
+  cmd_ct->add_option("--eps-d", ct_eps, "distance accuracy epsilon_d")->check(CLI::PositiveNumber);
+
   std::string plot_dir;
   auto* cmd_plot = app.add_subcommand("plot", "write PNG plots of a run directory");
   cmd_plot->add_option("run_dir", plot_dir, "run directory")->required();
@@ -41,6 +53,20 @@ int main(int argc, char** argv) {
   }
   try {
     if (cmd_run->parsed()) hb::run_simulation(run);
+    auto lines = [](const std::string& file, auto&& fn) {
+      if (file.empty()) return fn(std::cin, std::string("<stdin>"));
+      std::ifstream in(file);
+      if (!in) throw hb::InputError(file + ": cannot open");
+      return fn(in, file);
+    };
+    if (cmd_dist->parsed())
+      lines(dist_file, [](std::istream& in, const std::string& src) {
+        return hb::distance_queries(in, std::cout, src);
+      });
+    if (cmd_ct->parsed())
+      lines(ct_file, [&](std::istream& in, const std::string& src) {
+        return hb::contact_time_queries(in, std::cout, src, ct_eps);
+      });
     if (cmd_conv->parsed()) {
       if (conv_out.empty()) {
         conv_out = conv_in;

@@ -99,3 +99,69 @@ def test_bad_input_exits_2_and_writes_nothing(tmp_path, name, text, expect):
 def test_unknown_option_exits_2(tmp_path):
     r = run(["run", "--bogus"], tmp_path)
     assert r.returncode == 2
+
+
+def body(shape, pos, q=(1, 0, 0, 0), v=None, w=None):
+    b = {"shape": shape, "position": list(pos), "orientation": list(q)}
+    if v is not None:
+        b["velocity"] = list(v)
+        b["angular_velocity"] = list(w)
+    return b
+
+
+def query(cmd, lines, tmp_path):
+    r = subprocess.run([HB, cmd], input="\n".join(json.dumps(l) for l in lines) + "\n",
+                       capture_output=True, text=True, timeout=60, cwd=tmp_path)
+    return r, [json.loads(l) for l in r.stdout.strip().splitlines()]
+
+
+def test_distance_contract(tmp_path):
+    sph = {"type": "sphere", "radius": 0.5}
+    ell = {"type": "ellipsoid", "semi_axes": [2.0, 1.0, 0.5]}
+    c, s = 2 ** -0.5, 2 ** -0.5  # 90 degrees about z
+    pairs = [
+        {"a": body(sph, (0, 0, 0)), "b": body(sph, (3, 4, 0))},
+        {"a": body(ell, (0, 0, 0)), "b": body(sph, (0, 3, 0))},
+        {"a": body(ell, (0, 0, 0), (c, 0, 0, s)), "b": body(ell, (4.5, 0, 0))},
+        {"a": body(ell, (0, 0, 0)), "b": body(ell, (3.9, 0, 0))},  # overlapping: negative
+    ]
+    r, out = query("distance", pairs, tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert abs(out[0]["distance"] - 4.0) < 1e-12
+    assert abs(out[1]["distance"] - 1.5) < 1e-9
+    assert abs(out[2]["distance"] - 1.5) < 1e-9  # a rotated: extent 1 along x; b extends 2 towards a
+    assert out[3]["distance"] < 0
+    for o in out:
+        assert len(o["point_a"]) == 3 and len(o["point_b"]) == 3
+    # symmetric in a and b
+    r2, back = query("distance", [{"a": p["b"], "b": p["a"]} for p in pairs], tmp_path)
+    for o, p in zip(out, back):
+        assert abs(o["distance"] - p["distance"]) < 1e-9
+
+
+def test_contact_time_contract(tmp_path):
+    sph = {"type": "sphere", "radius": 0.5}
+    pairs = [
+        {"a": body(sph, (0, 0, 0), v=(1, 0, 0), w=(0, 0, 0)),
+         "b": body(sph, (3, 0, 0), v=(-1, 0, 0), w=(0, 0, 0)), "t_max": 10},
+        {"a": body(sph, (0, 0, 0), v=(1, 0, 0), w=(0, 0, 0)),
+         "b": body(sph, (3, 0, 0), v=(2, 0, 0), w=(0, 0, 0)), "t_max": 10},
+        {"a": body(sph, (0, 0, 0), v=(1, 0, 0), w=(0, 0, 0)),
+         "b": body(sph, (3, 0, 0), v=(-1, 0, 0), w=(0, 0, 0)), "t_max": 0.5},
+    ]
+    r, out = query("contact-time", pairs, tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert abs(out[0]["time"] - 1.0) < 1e-9
+    assert abs(out[0]["normal"][0] - 1.0) < 1e-9 and abs(out[0]["point"][0] - 1.5) < 1e-6
+    assert out[1]["time"] is None and out[2]["time"] is None
+
+
+@pytest.mark.parametrize("line,expect", [
+    ("not json", "malformed JSON"),
+    ('{"a": {}}', "a"),
+    ('{"a": {"shape": {"type": "cube"}, "position": [0,0,0], "orientation": [1,0,0,0]}, "b": {}}', "unknown shape type 'cube'"),
+    ('{"a": {"shape": {"type": "sphere", "radius": -1}, "position": [0,0,0], "orientation": [1,0,0,0]}, "b": {}}', "radius must be positive"),
+])
+def test_pair_queries_bad_input_exit_2(tmp_path, line, expect):
+    r = subprocess.run([HB, "distance"], input=line + "\n", capture_output=True, text=True, cwd=tmp_path)
+    assert r.returncode == 2 and "<stdin>:1" in r.stderr and expect in r.stderr, r.stderr
