@@ -1,0 +1,210 @@
+// ObbNeighbors (neighbors/obb_neighbors.hpp): lists against a brute-force all-pairs SAT after
+// random per-body rebuilds and during a run, every body inside its own box, and the run itself
+// against the cell-list run (same collisions), overlap-free (Perram–Wertheim) and conserving
+// energy. Prints tau_c (CPU microseconds per collision) of both methods.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <ctime>
+#include <random>
+#include <set>
+#include <utility>
+#include <vector>
+
+#include "geometry/plane.hpp"
+#include "neighbors/obb_neighbors.hpp"
+#include "observers/overlap.hpp"
+#include "system/rigid_setup.hpp"
+
+namespace hb {
+namespace {
+
+using EllipsoidNnlSim = Simulation<RigidBodies<Ellipsoid>, ObbNeighbors<Ellipsoid>>;
+
+EllipsoidNnlSim make_ellipsoid_nnl_simulation(const RigidSystemSpec& s, double shell) {
+  Box box;
+  State st = ellipsoid_start(s, box);
+  auto model = ellipsoid_model(s);
+  ObbNeighbors<Ellipsoid> nb(model.shape, shell);
+  return EllipsoidNnlSim(box, std::move(st), std::move(model), std::move(nb));
+}
+
+// Lists equal the brute-force all-pairs SAT over the current boxes (minimum image), are
+// symmetric and hold no duplicates.
+template <class NB>
+void expect_lists_match_brute_force(const NB& nb, const Box& box, std::size_t n) {
+  std::vector<std::set<std::uint32_t>> ref(n);
+  for (std::uint32_t i = 0; i < n; ++i)
+    for (std::uint32_t j = i + 1; j < n; ++j) {
+      const Obb& a = nb.box_of(i);
+      const Obb& b = nb.box_of(j);
+      const Vec3 d = b.centre - a.centre;
+      if (obb_overlap(a, b, Vec3(box.minimum_image(d) - d))) ref[i].insert(j), ref[j].insert(i);
+    }
+  long mismatches = 0;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    std::vector<std::uint32_t> got(nb.lists().begin(i), nb.lists().end(i));
+    std::sort(got.begin(), got.end());
+    EXPECT_TRUE(std::adjacent_find(got.begin(), got.end()) == got.end()) << "duplicate in " << i;
+    mismatches += !std::equal(got.begin(), got.end(), ref[i].begin(), ref[i].end());
+  }
+  EXPECT_EQ(mismatches, 0);
+}
+
+// Every body (at time now) is inside its own box: body-plane distance >= 0 to all six faces.
+template <class NB>
+double min_clearance(const NB& nb, const State& s, const Ellipsoid& e, double now) {
+  double m = kInf;
+  for (std::uint32_t i = 0; i < s.size(); ++i) {
+    const BodyState b = s.body_at(i, now);
+    const Pose p{b.r, b.q.toRotationMatrix()};
+    for (int f = 0; f < 6; ++f) m = std::min(m, plane_distance(e, p, obb_face(nb.box_of(i), f)));
+  }
+  return m;
+}
+
+TEST(ObbNeighbors, RandomRebuildsKeepListsEqualToBruteForce) {
+  std::mt19937_64 g(12345);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> nrm(0.0, 1.0);
+  const Ellipsoid e{1.0, 0.3, 0.3};
+  const std::size_t n = 300;
+  Box box;
+  box.L = Vec3(9.0, 10.0, 11.0);
+  State s;
+  s.resize(n);
+  auto random_pose = [&](std::uint32_t i) {
+    s.r[i] = Vec3(u(g) * 1.4 - 0.2, u(g) * 1.4 - 0.2, u(g) * 1.4 - 0.2).cwiseProduct(box.L);
+    s.q[i] = Quat(nrm(g), nrm(g), nrm(g), nrm(g)).normalized();
+  };
+  for (std::uint32_t i = 0; i < n; ++i) random_pose(i);
+  std::vector<Vec3> unwrapped = s.r;
+  ObbNeighbors<Ellipsoid> nb(e, 0.2);
+  nb.init(box, s, 0.0);
+  expect_lists_match_brute_force(nb, box, n);
+  auto noop = [](std::uint32_t, const Vec3&) {};
+  for (int round = 0; round < 20; ++round) {
+    for (int k = 0; k < 250; ++k) {
+      const auto i = static_cast<std::uint32_t>(u(g) * n);
+      random_pose(i);  // teleport: a rebuild must not rely on small moves
+      unwrapped[i] = s.r[i];
+      s.image[i].setZero();
+      nb.handle(i, Event{}, s, box, noop);
+    }
+    expect_lists_match_brute_force(nb, box, n);
+  }
+  for (std::uint32_t i = 0; i < n; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_GE(s.r[i][k], 0.0);
+      EXPECT_LT(s.r[i][k], box.L[k]);
+    }
+    EXPECT_LT((s.r[i] + s.image[i].cast<double>().cwiseProduct(box.L) - unwrapped[i]).norm(), 1e-12);
+    EXPECT_EQ(nb.box_of(i).centre, s.r[i]);
+  }
+  // restore from a snapshot rebuilds the same lists and boxes
+  ObbNeighbors<Ellipsoid> nb2(e, 0.2);
+  nb2.restore(box, s, nb.snapshot());
+  for (std::uint32_t i = 0; i < n; ++i) {
+    EXPECT_EQ(nb2.box_of(i).axes, nb.box_of(i).axes);
+    std::set<std::uint32_t> a(nb.lists().begin(i), nb.lists().end(i));
+    std::set<std::uint32_t> b(nb2.lists().begin(i), nb2.lists().end(i));
+    EXPECT_EQ(a, b);
+  }
+}
+
+TEST(ObbNeighbors, RunKeepsListsExactAndBodiesInsideTheirBoxes) {
+  RigidSystemSpec spec;  // N = 256, X0 = 2 (1, 0.5, 0.5), phi = 0.3
+  spec.seed = 7;
+  auto sim = make_ellipsoid_nnl_simulation(spec, 0.15);
+  const Ellipsoid& e = sim.model().shape;
+  double worst = kInf;
+  for (int block = 0; block < 40; ++block) {
+    for (int k = 0; k < 250; ++k) sim.step(kInf);
+    expect_lists_match_brute_force(sim.neighbors(), sim.box(), sim.state().size());
+    worst = std::min(worst, min_clearance(sim.neighbors(), sim.state(), e, sim.now()));
+  }
+  const auto& c = sim.event_counts();
+  std::printf("[ NNL ] 10000 events: %lu collisions, %lu rebuilds, min body-face clearance %.3e\n",
+              (unsigned long)c[int(EventType::Collision)], (unsigned long)c[int(EventType::Rebuild)],
+              worst);
+  EXPECT_GE(worst, 0.0);
+  EXPECT_GT(c[int(EventType::Rebuild)], 1000u);
+  EXPECT_EQ(sim.neighbors().truncated_searches(), 0u);
+}
+
+struct Hit {
+  std::uint32_t a, b;
+  double t;
+};
+template <class Sim>
+std::vector<Hit> first_collisions(Sim& sim, std::size_t n) {
+  std::vector<Hit> out;
+  while (out.size() < n) {
+    const StepInfo info = sim.step(kInf);
+    if (info.type == EventType::Collision && !info.stale)
+      out.push_back({std::min(info.record.a, info.record.b), std::max(info.record.a, info.record.b),
+                     info.record.time});
+  }
+  return out;
+}
+
+TEST(ObbNeighbors, SameCollisionsAsCellListsOverlapFreeAndConservative) {
+  RigidSystemSpec spec;
+  spec.seed = 11;
+  auto cells = make_ellipsoid_cell_simulation(spec);
+  auto nnl = make_ellipsoid_nnl_simulation(spec, 0.15);
+  const auto hc = first_collisions(cells, 1000);
+  const auto hn = first_collisions(nnl, 1000);
+  std::size_t same = 0;
+  double max_dt = 0.0;
+  for (; same < hc.size(); ++same) {
+    if (hc[same].a != hn[same].a || hc[same].b != hn[same].b) break;
+    max_dt = std::max(max_dt, std::abs(hc[same].t - hn[same].t));
+    if (std::abs(hc[same].t - hn[same].t) > 1e-9) break;
+  }
+  std::printf("[ NNL ] first %zu of 1000 collisions identical to cell lists (max |dt| %.2e)\n", same,
+              max_dt);
+  EXPECT_EQ(same, hc.size());
+  // longer run: no overlaps, energy conserved
+  const double e0 = nnl.model().kinetic_energy(nnl.state());
+  while (nnl.collisions() < 20000) nnl.step(kInf);
+  nnl.synchronize();
+  const double e1 = nnl.model().kinetic_energy(nnl.state());
+  const OverlapReport ov =
+      ellipsoid_overlaps(nnl.state().r, nnl.state().q, nnl.box(), spec.semi_axes);
+  std::printf("[ NNL ] 20000 collisions: overlaps %lu, min gap %.3e, relative energy drift %.2e\n",
+              (unsigned long)ov.overlaps, ov.min_distance, std::abs(e1 - e0) / e0);
+  EXPECT_EQ(ov.overlaps, 0u);
+  EXPECT_LT(std::abs(e1 - e0) / e0, 1e-10);
+}
+
+template <class Sim>
+double tau_c_us(Sim& sim, std::uint64_t warm, std::uint64_t measured) {
+  while (sim.collisions() < warm) sim.step(kInf);
+  const std::uint64_t c0 = sim.collisions();
+  const std::clock_t t0 = std::clock();
+  while (sim.collisions() < c0 + measured) sim.step(kInf);
+  return 1e6 * double(std::clock() - t0) / CLOCKS_PER_SEC / double(measured);
+}
+
+// Not an assertion (tests never assert on wall time): the figures for the report.
+TEST(ObbNeighbors, PrintTauC) {
+  for (const double X0 : {2.0, 0.5})
+    for (const double phi : {0.3, 0.5}) {
+      RigidSystemSpec spec;
+      spec.phi = phi;
+      spec.semi_axes = X0 > 1 ? Vec3(1.0, 0.5, 0.5) : Vec3(0.5, 1.0, 1.0);
+      spec.seed = 3;
+      const double shell = 0.15;
+      auto cells = make_ellipsoid_cell_simulation(spec);
+      auto nnl = make_ellipsoid_nnl_simulation(spec, shell);
+      const double tc = tau_c_us(cells, 1000, 2500);
+      const double tn = tau_c_us(nnl, 1000, 2500);
+      std::printf("[ TAU_C ] X0 = %.1f phi = %.2f N = 256: cells %.1f us, NNL (shell %.2f) %.1f us "
+                  "per collision\n", X0, phi, tc, shell, tn);
+    }
+}
+
+}  // namespace
+}  // namespace hb
