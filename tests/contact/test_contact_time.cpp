@@ -228,30 +228,30 @@ void run_kind(int kind, int count, uint64_t seed, CStats& st, double eps_d = 1e-
 
 TEST(Contact, ApproachingPairsVsReference) {
   CStats st;
-  run_kind(0, scaled_count(4000), 41, st);
+  run_kind(0, scaled_count(4000, 0.005), 41, st);
   st.print("approach");
 }
 TEST(Contact, FastSpinnersVsReference) {
   CStats st;
-  run_kind(1, scaled_count(2000), 42, st);
+  run_kind(1, scaled_count(2000, 0.005, 8), 42, st);
   st.print("spinners");
 }
 // Translating grazing passes: d(t) is convex (distance of a moving point to a convex set), its
 // minimum 1e-8..1e-4 is at t = 1, so none of them may be reported as a hit.
 TEST(Contact, GrazingPassesVsReference) {
   CStats st;
-  run_kind(2, scaled_count(1000), 43, st);
+  run_kind(2, scaled_count(1000, 0.001, 1), 43, st);
   st.print("grazing");
   EXPECT_EQ(st.hits, 0);
 }
 TEST(Contact, RotatingGrazingPassesVsReference) {
   CStats st;
-  run_kind(3, scaled_count(1000), 45, st);
+  run_kind(3, scaled_count(1000, 0.001, 1), 45, st);
   st.print("graze+rot");
 }
 TEST(Contact, JustTouchingVsReference) {
   CStats st;
-  run_kind(4, scaled_count(2000), 44, st);
+  run_kind(4, scaled_count(2000, 0.0005, 1), 44, st);
   st.print("touching");
   EXPECT_EQ(st.hits, st.n);  // every one overlaps at t = 1
 }
@@ -259,15 +259,15 @@ TEST(Contact, JustTouchingVsReference) {
 // the grazing search (Brent on d(t)) must find the negative minimum.
 TEST(Contact, JustTouchingCoarseEpsVsReference) {
   CStats st;
-  run_kind(4, scaled_count(1000), 46, st, 1e-2);
+  run_kind(4, scaled_count(1000, 0.002, 2), 46, st, 1e-2);
   st.print("touch,eps");
   EXPECT_EQ(st.hits, st.n);
-  EXPECT_GT(st.grazing, 0);
+  if (st.n >= 50) EXPECT_GT(st.grazing, 0);  // the path is exercised (Release: ~500 searches)
 }
 // The same grazing passes with the coarse eps_d: Brent must not invent contacts.
 TEST(Contact, GrazingCoarseEpsVsReference) {
   CStats st;
-  run_kind(3, scaled_count(500), 47, st, 1e-2);
+  run_kind(3, scaled_count(500, 0.002, 1), 47, st, 1e-2);
   st.print("graze,eps");
   EXPECT_EQ(st.false_hits, 0);
 }
@@ -276,7 +276,7 @@ TEST(Contact, GrazingCoarseEpsVsReference) {
 // contact_time(A, B) == contact_time(B, A): same time, same point, opposite normal.
 TEST(Contact, SymmetricInAandB) {
   Rng r(48);
-  for (int k = 0; k < scaled_count(1000); ++k) {
+  for (int k = 0; k < scaled_count(1000, 0.01); ++k) {
     const Scenario s = make_scenario(r, k % 2);
     const ContactResult ab = contact_time(
         ContactInput<Ellipsoid, Ellipsoid>{s.a, s.b, s.sa, s.sb, 0.0, 0.0, s.t_max, 1e-5});
