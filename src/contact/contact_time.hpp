@@ -295,10 +295,14 @@ struct Solver {
 
   void run() {
     double lo = in.t_start, hi = in.t_max;
+    // The window is widened by a margin: for bodies whose bounding sphere is tight (spheres)
+    // the window would end exactly at touching, where the distance is zero up to rounding and
+    // a rounding-negative sample would fake a contact.
+    const double margin = std::max(in.eps_d, 1e-9 * L);
     if (!(lo <= hi) ||
         !bounding_sphere_window(in.a, in.b, in.t_state,
-                                in.shape_a.bounding_radius() + in.shape_b.bounding_radius(), lo,
-                                hi)) {
+                                in.shape_a.bounding_radius() + in.shape_b.bounding_radius() + margin,
+                                lo, hi)) {
       out.status = ContactStatus::none;
       return;
     }
@@ -319,7 +323,10 @@ struct Solver {
       const double t1 = std::min(s.t + dt, hi);
       const Sample s1 = eval(t1);
       if (failed) return;
-      if (s1.d < 0.0) {
+      // A negative sample at rounding level between two samples where d increases is noise
+      // (a touching pair that separates), not a contact: d cannot dip within such a step.
+      const bool noise = s1.d < 0.0 && s1.d > -1e-12 * L && s.dd > 0.0 && s1.dd > 0.0;
+      if (s1.d < 0.0 && !noise) {
         if (s.d > 0.0) {
           solve_bracket(s, s1);
           return;

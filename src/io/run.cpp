@@ -389,6 +389,7 @@ class Driver {
                      {"contact_fallbacks", ss.fallbacks},
                      {"distance_fallbacks", ss.distance_fallbacks},
                      {"collision_distance_fallbacks", ss.collision_distance_fallbacks},
+                     {"grazing_separations", ss.grazing_separations},
                      {"note", "counts cover the whole run, equilibration included"}};
     }
     j["seed"] = cfg_.seed;

@@ -26,6 +26,7 @@ struct SolverStats {
   std::uint64_t fallbacks = 0;         // contact NR rejected, bracket shrunk instead
   std::uint64_t distance_fallbacks = 0;
   std::uint64_t collision_distance_fallbacks = 0;
+  std::uint64_t grazing_separations = 0;  // collisions given the minimum separation speed
 };
 
 // A contact-time solve that failed (every fallback exhausted): carries a reproducer in the
@@ -84,7 +85,21 @@ struct RigidBodies {
       throw SolverFailure(fmt::format("distance solver failed at the collision of {} and {}", i, j));
     if (d.status == DistanceStatus::fallback) ++stats.collision_distance_fallbacks;
     const Vec3 x_c = 0.5 * (d.point_a + d.point_b);
-    CollisionRecord rec = hb::collide(a, mass, b, mass, x_c, d.normal, r_ab);
+    // Grazing contacts: the contact-time solver and this impulse judge "approaching" from
+    // slightly different points (closest points vs their midpoint), so for a relative normal
+    // speed within rounding of zero they can disagree and the pair would be re-predicted to
+    // collide at this same instant forever. The bodies leave every collision separating at
+    // least at eps_v = 1e-8 of the pair's rate bound (through the growth term of the impulse
+    // rule: u'.n = -max(u.n, eps_v)); the energy change is of order eps_v^2, ~1e-16 relative.
+    const double un = contact_relative_velocity(a, b, x_c, r_ab).dot(d.normal);
+    const double rate = (b.v - a.v).norm() + (a.w.norm() + b.w.norm()) * shape.bounding_radius();
+    const double eps_v = 1e-8 * rate;
+    double lift = 0.0;
+    if (un < eps_v) {
+      lift = 0.5 * (eps_v - un);
+      ++stats.grazing_separations;
+    }
+    CollisionRecord rec = hb::collide(a, mass, b, mass, x_c, d.normal, r_ab, lift);
     s.v[i] = a.v, s.w[i] = a.w;
     s.v[j] = b.v, s.w[j] = b.w;
     rec.a = i;

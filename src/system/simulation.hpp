@@ -121,6 +121,17 @@ class Simulation {
       state_.advance_to(j, now_);
       info.record = model_.collide(state_, box_, i, j, now_);
       info.record.time = now_;
+      // Guard against an endless sequence of collisions at one instant (a solver/impulse
+      // inconsistency): fail loudly instead of hanging.
+      if (now_ == last_collision_time_) {
+        if (++same_time_collisions_ > 100000)
+          throw std::runtime_error("more than 100000 collisions at the same instant t = " +
+                                   std::to_string(now_) + " (bodies " + std::to_string(i) +
+                                   ", " + std::to_string(j) + ")");
+      } else {
+        last_collision_time_ = now_;
+        same_time_collisions_ = 0;
+      }
       ++state_.count[i];
       ++state_.count[j];
       ++counts_[static_cast<int>(EventType::Collision)];
@@ -214,6 +225,8 @@ class Simulation {
   std::vector<double> times_;        // their contact times
   std::array<std::uint64_t, kEventTypes> counts_{};
   std::uint64_t stale_ = 0;
+  double last_collision_time_ = -kInf;
+  std::uint64_t same_time_collisions_ = 0;
 };
 
 }  // namespace hb
