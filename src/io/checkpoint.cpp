@@ -240,4 +240,27 @@ void decode(const Reader& r, std::vector<std::array<int, 3>>& out) {
 }
 void decode(const Reader& r, std::vector<Vec3>& out) { out = r.vec3s(key("neighbors"), r.f.N); }
 
+gsd::LogArray encode(const ObbSnapshot& c) {
+  gsd::LogArray a{c.centre.size(), 10, {}};
+  a.values.reserve(10 * c.centre.size());
+  for (std::size_t i = 0; i < c.centre.size(); ++i)
+    a.values.insert(a.values.end(), {c.centre[i].x(), c.centre[i].y(), c.centre[i].z(), c.q[i].w(),
+                                     c.q[i].x(), c.q[i].y(), c.q[i].z(), c.half[i].x(),
+                                     c.half[i].y(), c.half[i].z()});
+  return a;
+}
+void decode(const Reader& r, ObbSnapshot& out) {
+  const std::uint64_t n = r.f.N;
+  const auto& a = r.get(key("neighbors"), n, 10);
+  out.centre.resize(n);
+  out.q.resize(n);
+  out.half.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double* x = a.values.data() + 10 * i;
+    out.centre[i] = Vec3(x[0], x[1], x[2]);
+    out.q[i] = Quat(x[3], x[4], x[5], x[6]);
+    out.half[i] = Vec3(x[7], x[8], x[9]);
+  }
+}
+
 }  // namespace hb::ckpt

@@ -13,6 +13,7 @@
 #include "io/config.hpp"
 #include "io/gsd_hoomd.hpp"
 #include "io/run.hpp"
+#include "neighbors/obb_neighbors.hpp"
 #include "system/box.hpp"
 #include "system/simulation.hpp"
 #include "system/state.hpp"
@@ -73,6 +74,8 @@ void decode(const Reader& r, std::vector<std::array<int, 3>>& out);
 void decode(const Reader& r, std::vector<Vec3>& out);
 gsd::LogArray encode(const std::vector<std::array<int, 3>>& c);
 gsd::LogArray encode(const std::vector<Vec3>& c);
+void decode(const Reader& r, ObbSnapshot& out);
+gsd::LogArray encode(const ObbSnapshot& c);
 }  // namespace ckpt
 
 // One trajectory frame (synchronised positions) at the simulation's current time.

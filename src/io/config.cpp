@@ -266,6 +266,7 @@ Config validate(const std::string& file, const toml::table& root) {
   }
   if (c.equilibrate_time < 0.0) bad("run", "equilibrate_time", "must not be negative");
   if (!(c.time > 0.0)) bad("run", "time", "must be positive");
+  if (!r.get("neighbors", "method")) c.neighbors_method = t == "sphere" ? "cells" : "nnl";
   if (c.neighbors_method != "cells" && c.neighbors_method != "nnl")
     bad("neighbors", "method", fmt::format("must be \"cells\" or \"nnl\" (got \"{}\")", c.neighbors_method));
   if (!(c.shell > 0.0)) bad("neighbors", "shell", "must be positive");

@@ -41,7 +41,7 @@ struct Config {
   double time = 0.0;
   std::uint64_t max_collisions = 0;  // 0: no limit; otherwise the measured run stops there
   // [neighbors]
-  std::string neighbors_method = "cells";
+  std::string neighbors_method = "cells";  // default: "cells" for spheres, "nnl" otherwise
   double shell = 0.15;
   // [solver]
   double eps_d = 1e-5;

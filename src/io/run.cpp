@@ -390,12 +390,14 @@ class Driver {
                      {"distance_fallbacks", ss.distance_fallbacks},
                      {"collision_distance_fallbacks", ss.collision_distance_fallbacks},
                      {"grazing_separations", ss.grazing_separations},
-                     {"note", "counts cover the whole run, equilibration included"}};
+                     {"note", "counts cover this session of the run (equilibration included; a resumed run counts from the resume)"}};
     }
     j["seed"] = cfg_.seed;
     j["neighbors"] = cfg_.neighbors_method;
     j["equilibrate_time"] = cfg_.equilibrate_time;
     j["trajectory_frames"] = st_.frames;
+    if constexpr (requires { sim_.neighbors().truncated_searches(); })
+      j["nnl_escape_searches_truncated"] = sim_.neighbors().truncated_searches();
     if (cfg_.obs_interval > 0.0) {
       const auto fit = corr_.diffusion();
       if (fit.points > 0) {
@@ -546,12 +548,13 @@ void run_simulation(const RunOptions& opt) {
                             return ellipsoid_overlaps(s.r, s.q, b, axes);
                           }};
       if (cfg.neighbors_method == "nnl")
-        throw ConfigError(fmt::format(
-            "{}: key 'neighbors.method': \"nnl\" for ellipsoids is not available yet; use \"cells\"",
-            cfg.source));
-      start_or_resume<EllipsoidCellSim>(cfg, opt, dir, [&] { return make_ellipsoid_cell_simulation(spec); },
-                                        [&] { return ellipsoid_model(spec); },
-                                        CellNeighbors(proto.interaction_range()), ops);
+        start_or_resume<EllipsoidListSim>(
+            cfg, opt, dir, [&] { return make_ellipsoid_list_simulation(spec, cfg.shell); },
+            [&] { return ellipsoid_model(spec); }, ObbNeighbors<Ellipsoid>(proto.shape, cfg.shell), ops);
+      else
+        start_or_resume<EllipsoidCellSim>(cfg, opt, dir, [&] { return make_ellipsoid_cell_simulation(spec); },
+                                          [&] { return ellipsoid_model(spec); },
+                                          CellNeighbors(proto.interaction_range()), ops);
     } else {
       throw ConfigError(fmt::format("{}: key 'shape.type': '{}' bodies are not yet supported by "
                                     "`hardbody run`", cfg.source, cfg.shape.type));

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "neighbors/cell_neighbors.hpp"
+#include "neighbors/obb_neighbors.hpp"
 #include "shapes/ellipsoid.hpp"
 #include "system/init.hpp"
 #include "system/rigid_bodies.hpp"
@@ -28,6 +29,7 @@ struct RigidSystemSpec {
 };
 
 using EllipsoidCellSim = Simulation<RigidBodies<Ellipsoid>, CellNeighbors>;
+using EllipsoidListSim = Simulation<RigidBodies<Ellipsoid>, ObbNeighbors<Ellipsoid>>;
 
 // FCC cell counts (mx, my, mz) with 4 mx my mz >= n that make the stretched box closest to a
 // cube, and the largest packing fraction that lattice allows.
@@ -94,6 +96,15 @@ inline EllipsoidCellSim make_ellipsoid_cell_simulation(const RigidSystemSpec& s)
   auto model = ellipsoid_model(s);
   const double range = model.interaction_range();
   return EllipsoidCellSim(box, std::move(st), std::move(model), CellNeighbors(range));
+}
+
+// Oriented-bounding-box neighbour lists with shell `shell` (paper section 3.3).
+inline EllipsoidListSim make_ellipsoid_list_simulation(const RigidSystemSpec& s, double shell) {
+  Box box;
+  State st = ellipsoid_start(s, box);
+  auto model = ellipsoid_model(s);
+  ObbNeighbors<Ellipsoid> nb(model.shape, shell);
+  return EllipsoidListSim(box, std::move(st), std::move(model), std::move(nb));
 }
 
 }  // namespace hb

@@ -179,32 +179,5 @@ TEST(ObbNeighbors, SameCollisionsAsCellListsOverlapFreeAndConservative) {
   EXPECT_LT(std::abs(e1 - e0) / e0, 1e-10);
 }
 
-template <class Sim>
-double tau_c_us(Sim& sim, std::uint64_t warm, std::uint64_t measured) {
-  while (sim.collisions() < warm) sim.step(kInf);
-  const std::uint64_t c0 = sim.collisions();
-  const std::clock_t t0 = std::clock();
-  while (sim.collisions() < c0 + measured) sim.step(kInf);
-  return 1e6 * double(std::clock() - t0) / CLOCKS_PER_SEC / double(measured);
-}
-
-// Not an assertion (tests never assert on wall time): the figures for the report.
-TEST(ObbNeighbors, PrintTauC) {
-  for (const double X0 : {2.0, 0.5})
-    for (const double phi : {0.3, 0.5}) {
-      RigidSystemSpec spec;
-      spec.phi = phi;
-      spec.semi_axes = X0 > 1 ? Vec3(1.0, 0.5, 0.5) : Vec3(0.5, 1.0, 1.0);
-      spec.seed = 3;
-      const double shell = 0.15;
-      auto cells = make_ellipsoid_cell_simulation(spec);
-      auto nnl = make_ellipsoid_nnl_simulation(spec, shell);
-      const double tc = tau_c_us(cells, 1000, 2500);
-      const double tn = tau_c_us(nnl, 1000, 2500);
-      std::printf("[ TAU_C ] X0 = %.1f phi = %.2f N = 256: cells %.1f us, NNL (shell %.2f) %.1f us "
-                  "per collision\n", X0, phi, tc, shell, tn);
-    }
-}
-
 }  // namespace
 }  // namespace hb
