@@ -20,8 +20,12 @@ TEST(ContactRegression, TouchingSeparatingTightBodiesAreNotAContact) {
   const ContactResult r = contact_time(in);
   EXPECT_NE(r.time, now) << "a fake contact at the start";
   // the bodies may meet again later (they are in a dense fluid), but not at once
-  if (r.status == ContactStatus::hit) EXPECT_GT(r.time - now, 1e-6);
+  if (r.status == ContactStatus::hit) {
+    EXPECT_GT(r.time - now, 1e-6);
+  }
   ContactInput<Ellipsoid, Ellipsoid> sw{e, e, b, a, now, now, now + 1.0, 1e-5};
   const ContactResult r2 = contact_time(sw);
-  if (r2.status == ContactStatus::hit) EXPECT_GT(r2.time - now, 1e-6);
+  if (r2.status == ContactStatus::hit) {
+    EXPECT_GT(r2.time - now, 1e-6);
+  }
 }
