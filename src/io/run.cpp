@@ -237,6 +237,10 @@ class Driver {
         writer->sync();
         st_.frames += 1;
         st_.next_snapshot += cfg_.snapshot_interval;
+        // every snapshot is also checked for overlaps by the independent test
+        const auto rep = ops_.overlaps(synchronized_state(sim_), sim_.box());
+        snapshot_overlaps_ += rep.overlaps;
+        snapshot_min_gap_ = std::min(snapshot_min_gap_, rep.min_distance);
       }
       if (st_.phase == 1) sample_observables();
       const double block_end = st_.phase == 0 ? t_eq : std::min(t_end, st_.block_start + cfg_.log_interval);
@@ -396,6 +400,8 @@ class Driver {
     j["neighbors"] = cfg_.neighbors_method;
     j["equilibrate_time"] = cfg_.equilibrate_time;
     j["trajectory_frames"] = st_.frames;
+    j["snapshot_overlaps"] = snapshot_overlaps_;  // summed over this session's snapshots
+    j["snapshot_min_distance"] = snapshot_min_gap_;
     if constexpr (requires { sim_.neighbors().truncated_searches(); })
       j["nnl_escape_searches_truncated"] = sim_.neighbors().truncated_searches();
     if (cfg_.obs_interval > 0.0) {
@@ -414,9 +420,9 @@ class Driver {
       std::fprintf(stderr, "hardbody: %s: t=%.6g collisions=%llu Z=%.5f +- %.5f overlaps=%llu -> %s\n",
                    cfg_.source.c_str(), pressure_.measured_time(), (unsigned long long)ncoll, Z.mean,
                    Z.error, (unsigned long long)rep.overlaps, dir_.c_str());
-    if (rep.overlaps > 0)
-      throw RunFailure(fmt::format("{} overlapping pairs in the final state (min gap {:.3g})",
-                                   rep.overlaps, rep.min_distance));
+    if (rep.overlaps > 0 || snapshot_overlaps_ > 0)
+      throw RunFailure(fmt::format("{} overlapping pairs in the final state (min gap {:.3g}), {} in snapshots",
+                                   rep.overlaps, rep.min_distance, snapshot_overlaps_));
   }
 
   const Config& cfg_;
@@ -432,6 +438,8 @@ class Driver {
   NematicOrder nem_;
   Progress progress_;
   double cpu_mark_ = 0.0, wall_mark_ = 0.0, last_checkpoint_ = 0.0;
+  std::uint64_t snapshot_overlaps_ = 0;
+  double snapshot_min_gap_ = kInf;
 };
 
 template <class Sim>
