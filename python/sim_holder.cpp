@@ -1,0 +1,130 @@
+#include "sim_holder.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+#include "io/checkpoint.hpp"
+#include "system/init.hpp"
+#include "system/rigid_setup.hpp"
+#include "system/sphere_setup.hpp"
+
+namespace hb::python {
+
+namespace {
+
+// The simulation plus the two things the driver knows about the bodies beyond the event loop.
+template <class Sim, class Kinetic, class Overlaps>
+class Holder final : public SimHandle {
+ public:
+  Holder(Sim sim, double mass, Kinetic kinetic, Overlaps overlaps)
+      : sim_(std::move(sim)), mass_(mass), kinetic_(kinetic), overlaps_(overlaps) {}
+
+  double now() const override { return sim_.now(); }
+  std::uint64_t collisions() const override { return sim_.collisions(); }
+  std::uint64_t stale_events() const override { return sim_.stale_events(); }
+  std::array<std::uint64_t, kEventTypes> event_counts() const override { return sim_.event_counts(); }
+  const Box& box() const override { return sim_.box(); }
+  State synchronized() const override { return synchronized_state(sim_); }
+  double kinetic_energy() const override { return kinetic_(sim_.state()); }
+  double temperature() const override {
+    return 2.0 * hb::kinetic_energy(sim_.state(), mass_) / (3.0 * double(sim_.state().size()));
+  }
+  OverlapReport overlaps() const override { return overlaps_(synchronized_state(sim_), sim_.box()); }
+
+  Stop advance(double t_end, std::uint64_t max_collisions, VirialPressure& pressure,
+               const std::function<void()>& poll) override {
+    std::uint64_t steps = 0;
+    if (sim_.collisions() >= max_collisions) return Stop::collisions;
+    for (;;) {
+      const StepInfo s = sim_.step(t_end);
+      if (s.type == EventType::None) return Stop::time;
+      if (s.type == EventType::Collision && !s.stale) {
+        pressure.on_collision(s.record);
+        if (sim_.collisions() >= max_collisions) return Stop::collisions;
+      }
+      if ((++steps & 4095) == 0) poll();
+    }
+  }
+
+ private:
+  Sim sim_;
+  double mass_;
+  Kinetic kinetic_;
+  Overlaps overlaps_;
+};
+
+template <class Sim, class K, class O>
+std::unique_ptr<SimHandle> hold(Sim sim, double mass, K kinetic, O overlaps) {
+  return std::make_unique<Holder<Sim, K, O>>(std::move(sim), mass, kinetic, overlaps);
+}
+
+// The run driver's box-size rule (src/io/run.cpp, plan_*): at least two interaction ranges.
+void require_box(const Config& c, double side, double range) {
+  if (side < 2.0 * range)
+    throw ConfigError(fmt::format(
+        "{}: key 'system.particles': {} particles at packing fraction {} give a box side of "
+        "{:.3g}, less than two interaction ranges ({:.3g}); use more particles",
+        c.source, c.particles, c.packing_fraction, side, 2.0 * range));
+}
+
+std::unique_ptr<SimHandle> spheres(const Config& c) {
+  SphereSystemSpec spec;
+  spec.n = c.particles;
+  spec.phi = c.packing_fraction;
+  spec.sigma = 2.0 * c.shape.radius;
+  spec.mass = c.mass;
+  spec.kT = c.temperature;
+  spec.seed = c.seed;
+  spec.shell = c.neighbors_method == "nnl" ? c.shell : 0.0;
+  require_box(c, cubic_box_for(spec.n, c.shape.volume(), spec.phi).L.x(), spec.sigma + spec.shell);
+  auto kinetic = [m = spec.mass](const State& s) { return hb::kinetic_energy(s, m); };
+  auto overlaps = [sigma = spec.sigma](const State& s, const Box& b) {
+    return sphere_overlaps(s.r, b, sigma);
+  };
+  if (spec.shell > 0.0)
+    return hold(make_hard_sphere_list_simulation(spec), spec.mass, kinetic, overlaps);
+  return hold(make_hard_sphere_cell_simulation(spec), spec.mass, kinetic, overlaps);
+}
+
+std::unique_ptr<SimHandle> ellipsoids(const Config& c) {
+  RigidSystemSpec spec;
+  spec.n = c.particles;
+  spec.phi = c.packing_fraction;
+  spec.semi_axes = c.shape.semi_axes;
+  spec.mass = c.mass;
+  spec.inertia = c.shape.inertia;
+  spec.kT = c.temperature;
+  spec.seed = c.seed;
+  spec.eps_d = c.eps_d;
+  // The box side follows from the lattice ellipsoid_start builds; it checks the density itself.
+  Box box;
+  (void)ellipsoid_start(spec, box);
+  require_box(c, box.L.minCoeff(), 2.0 * spec.semi_axes.maxCoeff());
+  const auto proto = ellipsoid_model(spec);
+  auto kinetic = [proto](const State& s) { return proto.kinetic_energy(s); };
+  auto overlaps = [axes = spec.semi_axes](const State& s, const Box& b) {
+    return ellipsoid_overlaps(s.r, s.q, b, axes);
+  };
+  if (c.neighbors_method == "nnl")
+    return hold(make_ellipsoid_list_simulation(spec, c.shell), spec.mass, kinetic, overlaps);
+  return hold(make_ellipsoid_cell_simulation(spec), spec.mass, kinetic, overlaps);
+}
+
+}  // namespace
+
+std::unique_ptr<SimHandle> make_simulation(const Config& c) {
+  try {
+    if (c.shape.type == "sphere") return spheres(c);
+    if (c.shape.type == "ellipsoid") return ellipsoids(c);
+  } catch (const std::invalid_argument& e) {  // the lattice starts reject a too dense system
+    throw ConfigError(fmt::format("{}: key 'system.packing_fraction': {} ({} particles at {})",
+                                  c.source, e.what(), c.particles, c.packing_fraction));
+  }
+  throw ConfigError(fmt::format("{}: key 'shape.type': '{}' bodies are not yet supported", c.source,
+                                c.shape.type));
+}
+
+}  // namespace hb::python
