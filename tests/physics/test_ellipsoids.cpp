@@ -2,6 +2,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "observers/correlations.hpp"
 
 #include "physics/run_helper.hpp"
 
@@ -65,4 +70,37 @@ TEST(EllipsoidPhysics, UnitAspectRatioReproducesHardSpheres) {
   EXPECT_LE(ze / z, 0.01);
   EXPECT_LE(std::abs(z - zref), 3.0 * ze);
   EXPECT_EQ(s["overlaps"].get<int>(), 0);
+}
+
+// Free rotors: at very low density the orientational correlation C2(t) of spherical tops
+// follows the analytic free-rotor curve for the set inertia (observers/correlations.hpp,
+// c2_free_rotor; docs/observables.md). Tolerance: a free rotor keeps its spin, so the time
+// origins of one body are not independent samples; only the N bodies are. Each contributes an
+// origin-averaged P2 of variance <= 0.2, so the standard error is sqrt(0.2 / N); 5 of them.
+TEST(EllipsoidPhysics, FreeRotorC2FollowsAnalyticCurve) {
+  const int n = 4000;
+  const double inertia = 0.4 * 0.25;  // default 2/5 m b^2 with b = 0.5
+  std::string cfg = ellipsoid_config(n, 0.001, 1.0, 0.5, 0.0, 3.0, 8, 0.5);
+  cfg = cfg.substr(0, cfg.find("[observables]")) +
+        "[observables]\ninterval = 0.02\norigin_every = 5\nmax_lag = 1.0\ngr_interval = 0.0\n";
+  const auto s = run_config("rotors", cfg);
+  std::ifstream in(std::filesystem::temp_directory_path() / "hardbody-test-rotors" / "out" / "correlations.tsv");
+  ASSERT_TRUE(in);
+  std::string line;
+  int rows = 0;
+  double worst = 0.0;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#' || line[0] == 't') continue;
+    std::stringstream ss(line);
+    double t, msd, samples, c2;
+    ss >> t >> msd >> samples >> c2;
+    const double ref = hb::c2_free_rotor(t, 1.0 / inertia);
+    const double se = std::sqrt(0.2 / n);
+    worst = std::max(worst, std::abs(c2 - ref) / se);
+    EXPECT_LE(std::abs(c2 - ref), 5.0 * se) << "t=" << t << " C2=" << c2 << " free rotor " << ref;
+    ++rows;
+  }
+  std::printf("free rotors: %d lags, worst deviation %.2f standard errors, collisions %llu\n", rows,
+              worst, (unsigned long long)s["collisions"].get<std::uint64_t>());
+  EXPECT_GT(rows, 40);
 }
