@@ -1,0 +1,296 @@
+// Superquadric |x/a|^n + |y/b|^m + |z/c|^p <= 1 (paper section 5, Eq. SQdef), exponents >= 2,
+// semi-axes (a, b, c) along body x, y, z.  Derivations and measurements: docs/superquadrics.md.
+//
+// Implicit function.  With t_i = |x_i| / a_i, e = (n, m, p), S(x) = sum_i t_i^e_i and
+// E = max(e), we use
+//     F(x) = S(x)^(1/E) - 1                       (same zero set as the paper's S - 1)
+// instead of S - 1.  When all exponents are equal F is the gauge (Minkowski norm) of the body
+// minus one: convex, positively homogeneous of degree 1, so F grows linearly away from the
+// surface, its gradient is constant along rays and Newton steps along a ray are exact.  With
+// mixed exponents it is homogeneous of degree between e_min/E and 1 along every ray (never
+// steeper than linear), whereas S - 1 grows like |x|^20 for p = 20 (Newton from outside then
+// creeps back 1/20 of the way per step and overshoots wildly from inside).  |grad F| on the
+// surface lies in [e_min/(E a_max), 1/a_min]: no scale that grows with the exponent.
+//     grad F = rho/S * (e_i/E) sgn(x_i) t_i^(e_i-1) / a_i,                      rho = S^(1/E)
+//     hess F = diag( rho/S * e_i (e_i-1) / (E a_i^2) * t_i^(e_i-2) ) - (E-1)/rho * g g^T
+// (g = grad F).  The two diagonal terms nearly cancel where one term w_i = t_i^e_i dominates S
+// (F is then nearly linear along x_i); the diagonal is evaluated in the equivalent form
+//     H_ii = rho/S e_i t_i^(e_i-2) / (E a_i^2) [ (e_i/E - 1) + (E-1)(e_i/E) sigma_i ],
+// sigma_i = sum_{j != i} w_j / S, which has no cancellation when e_i = E.  For e_i >= 2 every power t^(e_i-1), t^(e_i-2) is bounded as t_i -> 0 (t^0 = 1
+// for e_i = 2), so F, grad F and hess F are finite at and near the coordinate planes.  At a
+// point with x_i = 0 and e_i > 2 the i-th diagonal entry is exactly 0: the surface has zero
+// curvature there (the flat face centres of a high-exponent body), a genuine property of the
+// shape that every f with this zero set shares in its tangential Hessian.  Powers are taken
+// with pow() when S lies in [1e-250, 1e250]; outside (only far from the surface or within
+// ~1e-250^(1/e) of the centre) the same formulas are evaluated from logarithms, so nothing
+// overflows or underflows.  At the centre itself F = -1 and grad, hess are returned as 0
+// (F is not differentiable there when the exponents differ; no solver evaluates it there).
+//
+// Support function (SupportShape).  max n.x over the body: the Lagrange condition
+// n_i = lambda e_i t_i^(e_i-1) sgn(x_i) / a_i gives t_i = (c_i / lambda)^(1/(e_i-1)),
+// c_i = |n_i| a_i / e_i, and the constraint sum t_i^e_i = 1 becomes the 1-D equation
+//     sum_i (c_i / lambda)^(q_i) = 1,   q_i = e_i / (e_i - 1) in (1, 2],
+// solved for s = log lambda by Newton on psi(s) = log sum exp(q_i (log c_i - s)), which is
+// convex and decreasing with slope in [-q_max, -q_min]; started at s0 = max log c_i (psi >= 0,
+// left of the root) Newton increases monotonically to the root (no overshoot, no bracket
+// needed), in ~5 steps.  h = n.x.  Support Hessian (dx/dn):
+//     (1/lambda) [ diag(a_i^2 t_i^(2-e_i) / (e_i (e_i-1))) - (r.x)(r.x)^T / W ],
+//     r_i = 1/(e_i-1),  W = sum q_i t_i^e_i,
+// which is infinite at n_i = 0 when e_i > 2 (the support point sweeps across the flat face);
+// there the diagonal is capped at 1e12 h / |n|^2 (a large finite value, documented).
+//
+// Ray from the centre: s u with sum (s |u_i| / a_i)^e_i = 1, the same kind of 1-D equation in
+// log s (slopes e_i), solved the same way.
+//
+// Bounding radius: max |x|^2 over the surface = max sum a_i^2 u_i^(2/e_i) over the simplex
+// u_i = t_i^e_i >= 0, sum u_i = 1, a concave maximisation (2/e_i <= 1) solved exactly by its KKT
+// conditions (again a 1-D equation of the same kind); returned with a 1e-12 relative margin.
+// Inscribed radius: min(a, b, c) exactly (|x|^2 = sum a_i^2 t_i^2 >= a_min^2 sum t_i^e_i).
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "math/types.hpp"
+#include "shapes/shape.hpp"
+
+namespace hb {
+
+namespace sq_detail {
+
+// Root s of sum_i exp(k_i (v_i - s)) = 1 (k_i > 0; v_i = -inf drops term i; at least one
+// finite v_i).  psi(s) = log sum exp(k_i (v_i - s)) is convex and decreasing; Newton from
+// s0 = max v_i (where psi >= 0) increases monotonically to the root.
+inline double log_root(const Vec3& k, const Vec3& v) {
+  double s = std::max({v[0], v[1], v[2]});
+  for (int it = 0; it < 100; ++it) {
+    double top = -std::numeric_limits<double>::infinity();
+    for (int i = 0; i < 3; ++i)
+      if (v[i] > -kInf) top = std::max(top, k[i] * (v[i] - s));
+    double sum = 0.0, dsum = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      if (!(v[i] > -kInf)) continue;
+      const double w = std::exp(k[i] * (v[i] - s) - top);
+      sum += w;
+      dsum += k[i] * w;
+    }
+    const double psi = top + std::log(sum);
+    const double step = psi * sum / dsum;  // -psi / psi'
+    if (!(step > 0.0)) break;              // at (or, by rounding, past) the root
+    s += step;
+    if (step <= 2e-16 * std::max(1.0, std::abs(s))) break;
+  }
+  return s;
+}
+
+}  // namespace sq_detail
+
+struct Superquadric {
+  double a = 1.0, b = 1.0, c = 1.0;  // semi-axes along body x, y, z
+  double n = 2.0, m = 2.0, p = 2.0;  // exponents (>= 2) of |x/a|, |y/b|, |z/c|
+
+  Vec3 axes() const { return Vec3(a, b, c); }
+  Vec3 exponents() const { return Vec3(n, m, p); }
+  double e_max() const { return std::max({n, m, p}); }
+
+  // rho/S * t_i^(e_i-1), rho/S * t_i^(e_i-2) and rho = S^(1/E) at x (see header).
+  struct Powers {
+    Vec3 t, d1, d2;  // t_i, rho/S t_i^(e_i-1), rho/S t_i^(e_i-2)
+    double rho = 0.0;
+    bool centre = false;
+  };
+  Powers powers(const Vec3& x) const {
+    Powers P;
+    const Vec3 e = exponents(), ax = axes();
+    const double E = e_max();
+    P.t = x.cwiseAbs().cwiseQuotient(ax);
+    if (P.t.maxCoeff() == 0.0) {
+      P.centre = true;
+      P.d1.setZero();
+      P.d2.setZero();
+      return P;
+    }
+    Vec3 w;
+    double S = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      P.d2[i] = std::pow(P.t[i], e[i] - 2.0);  // pow(0, 0) = 1 for e_i = 2
+      P.d1[i] = P.d2[i] * P.t[i];
+      w[i] = P.d1[i] * P.t[i];
+      S += w[i];
+    }
+    if (S >= 1e-250 && S <= 1e250) {
+      P.rho = std::pow(S, 1.0 / E);
+      const double k = P.rho / S;
+      P.d1 *= k;
+      P.d2 *= k;
+      return P;
+    }
+    // Far from the surface: the same quantities from logarithms.
+    Vec3 lt, l;
+    double lmax = -kInf;
+    for (int i = 0; i < 3; ++i) {
+      lt[i] = P.t[i] > 0.0 ? std::log(P.t[i]) : -kInf;
+      l[i] = P.t[i] > 0.0 ? e[i] * lt[i] : -kInf;
+      lmax = std::max(lmax, l[i]);
+    }
+    double sum = 0.0;
+    for (int i = 0; i < 3; ++i) sum += std::exp(l[i] - lmax);
+    const double LS = lmax + std::log(sum);  // log S
+    const double lk = LS / E - LS;           // log(rho / S)
+    P.rho = std::exp(LS / E);
+    for (int i = 0; i < 3; ++i) {
+      if (P.t[i] > 0.0) {
+        P.d1[i] = std::exp((e[i] - 1.0) * lt[i] + lk);
+        P.d2[i] = e[i] == 2.0 ? std::exp(lk) : std::exp((e[i] - 2.0) * lt[i] + lk);
+      } else {
+        P.d1[i] = 0.0;
+        P.d2[i] = e[i] == 2.0 ? std::exp(lk) : 0.0;
+      }
+    }
+    return P;
+  }
+
+  double f(const Vec3& x) const {
+    const Powers P = powers(x);
+    return P.centre ? -1.0 : P.rho - 1.0;
+  }
+  Vec3 grad(const Vec3& x) const { return grad_of(x, powers(x)); }
+  Mat3 hessian(const Vec3& x) const {
+    const Powers P = powers(x);
+    if (P.centre) return Mat3::Zero();
+    const Vec3 e = exponents(), ax = axes();
+    const double E = e_max();
+    const Vec3 g = grad_of(x, P);
+    Mat3 H = -((E - 1.0) / P.rho) * g * g.transpose();
+    // Diagonal without cancellation (see header): with sigma_i = sum_{j != i} w_j / S,
+    // H_ii = rho/S e_i t_i^(e_i-2) / (E a_i^2) [(e_i/E - 1) + (E-1) (e_i/E) sigma_i].
+    const Vec3 wS = P.t.cwiseProduct(P.d1) / P.rho;  // w_j / S
+    for (int i = 0; i < 3; ++i) {
+      const double sigma = wS.sum() - wS[i];
+      H(i, i) = e[i] * P.d2[i] / (E * ax[i] * ax[i]) *
+                ((e[i] / E - 1.0) + (E - 1.0) * (e[i] / E) * sigma);
+    }
+    return H;
+  }
+
+  double volume() const {
+    return 8.0 * a * b * c * std::tgamma(1.0 + 1.0 / n) * std::tgamma(1.0 + 1.0 / m) *
+           std::tgamma(1.0 + 1.0 / p) / std::tgamma(1.0 + 1.0 / n + 1.0 / m + 1.0 / p);
+  }
+  // max |x| over the body (exact, see header) with a 1e-12 relative safety margin.
+  double bounding_radius() const { return farthest_point().norm() * (1.0 + 1e-12); }
+  double inscribed_radius() const { return std::min({a, b, c}); }
+  Vec3 half_extents() const { return axes(); }
+
+  // The surface point along u (any length, nonzero): s u with sum (s |u_i| / a_i)^e_i = 1.
+  Vec3 ray_surface(const Vec3& u) const {
+    const Vec3 e = exponents(), ax = axes();
+    Vec3 v;  // log(|u_i| / a_i);  the root is log(1/s)
+    for (int i = 0; i < 3; ++i) v[i] = u[i] != 0.0 ? std::log(std::abs(u[i]) / ax[i]) : -kInf;
+    return u * std::exp(-sq_detail::log_root(e, v));
+  }
+
+  // A surface point at distance max |x| from the centre (first octant).  KKT of
+  // max sum a_i^2 u_i^(2/e_i) on the simplex: u_i = (2 a_i^2 / (e_i nu))^(e_i/(e_i-2)) for
+  // e_i > 2; axes with e_i = 2 have constant slope a_i^2, so the largest of them takes the
+  // remaining mass when nu = its a_i^2 leaves some, otherwise they get none.
+  Vec3 farthest_point() const {
+    const Vec3 e = exponents(), ax = axes();
+    Vec3 k, v;
+    double a2 = 0.0;  // largest a_i^2 among e_i = 2
+    int i2 = -1;
+    bool any_high = false;
+    for (int i = 0; i < 3; ++i) {
+      if (e[i] > 2.0) {
+        k[i] = e[i] / (e[i] - 2.0);
+        v[i] = std::log(2.0 * ax[i] * ax[i] / e[i]);
+        any_high = true;
+      } else {
+        k[i] = 1.0;
+        v[i] = -kInf;
+        if (ax[i] * ax[i] > a2) {
+          a2 = ax[i] * ax[i];
+          i2 = i;
+        }
+      }
+    }
+    Vec3 u = Vec3::Zero();
+    auto fill = [&](double log_nu) {
+      for (int i = 0; i < 3; ++i)
+        if (e[i] > 2.0) u[i] = std::exp(k[i] * (v[i] - log_nu));
+    };
+    if (!any_high) {
+      u[i2] = 1.0;
+    } else if (i2 >= 0) {
+      fill(std::log(a2));
+      const double g = u.sum();
+      if (g <= 1.0) u[i2] = 1.0 - g;
+      else fill(sq_detail::log_root(k, v));
+    } else {
+      fill(sq_detail::log_root(k, v));
+    }
+    Vec3 x;
+    for (int i = 0; i < 3; ++i) x[i] = ax[i] * std::pow(u[i], 1.0 / e[i]);
+    return ray_surface(x);  // exact surface point (removes the rounding of the simplex sum)
+  }
+
+  // Support function h(d) = max_{x in body} d.x, its gradient and its Hessian (see header).
+  double support(const Vec3& d) const { return d.dot(support_point(d)); }
+  Vec3 support_point(const Vec3& d) const {
+    double lambda;
+    return support_point(d, lambda);
+  }
+  Mat3 support_hessian(const Vec3& d) const {
+    double lambda;
+    const Vec3 x = support_point(d, lambda);
+    const Vec3 e = exponents(), ax = axes();
+    if (!(lambda > 0.0)) return Mat3::Zero();
+    const double h = d.dot(x), cap = 1e12 * h / d.squaredNorm();
+    Vec3 rx;
+    double W = 0.0;
+    Mat3 H = Mat3::Zero();
+    for (int i = 0; i < 3; ++i) {
+      const double t = std::abs(x[i]) / ax[i];
+      rx[i] = x[i] / (e[i] - 1.0);
+      W += e[i] / (e[i] - 1.0) * std::pow(t, e[i]);
+      const double diag = ax[i] * ax[i] * std::pow(t, 2.0 - e[i]) / (e[i] * (e[i] - 1.0));
+      H(i, i) = std::min(diag / lambda, cap);
+    }
+    return H - rx * rx.transpose() / (lambda * W);
+  }
+
+ private:
+  Vec3 grad_of(const Vec3& x, const Powers& P) const {
+    if (P.centre) return Vec3::Zero();
+    const Vec3 e = exponents(), ax = axes();
+    const double E = e_max();
+    Vec3 g;
+    for (int i = 0; i < 3; ++i)
+      g[i] = std::copysign(e[i] / (E * ax[i]) * P.d1[i], x[i]);
+    return g;
+  }
+  // Support point and the multiplier lambda (0 for d = 0).
+  Vec3 support_point(const Vec3& d, double& lambda) const {
+    const Vec3 e = exponents(), ax = axes();
+    if (d.cwiseAbs().maxCoeff() == 0.0) {
+      lambda = 0.0;
+      return Vec3::Zero();
+    }
+    Vec3 q, lc;  // q_i = e_i/(e_i-1), log c_i = log(|d_i| a_i / e_i)
+    for (int i = 0; i < 3; ++i) {
+      q[i] = e[i] / (e[i] - 1.0);
+      lc[i] = d[i] != 0.0 ? std::log(std::abs(d[i]) * ax[i] / e[i]) : -kInf;
+    }
+    const double s = sq_detail::log_root(q, lc);
+    lambda = std::exp(s);
+    Vec3 x;
+    for (int i = 0; i < 3; ++i)
+      x[i] = d[i] != 0.0 ? std::copysign(ax[i] * std::exp((lc[i] - s) / (e[i] - 1.0)), d[i])
+                         : 0.0;
+    return x;
+  }
+};
+
+static_assert(SupportShape<Superquadric>);
+
+}  // namespace hb
