@@ -41,6 +41,25 @@
 //  contact at that time (`hit`, initial_overlap = true); if they separate (just after a
 //  collision, rounding) the search continues and only a later sign change counts.
 //  A distance solve that fails makes the result `failed` (never a silent `none`).
+//
+// Growth (Lubachevsky–Stillinger).  `ContactInput::growth` optionally scales both shapes about
+// their centres by the common factor s(t) = s + rate (t - t_state) (default s = 1, rate = 0:
+// rigid bodies, bit-for-bit the algorithm above).  A body scaled by s has f_s(y) = f(y / s) in
+// its frame, grad f_s = grad f(y/s) / s, Hessian H(y/s) / s^2 (`scaled_shape`; ellipsoids and
+// spheres scale their semi-axes directly).  Scaling about the centre is the velocity field
+// (s'/s) (x - r) on top of the rigid motion, so everything above carries over with the
+// material velocity u = v + w x (x - r) replaced by
+//     U(x) = v + w x (x - r) + (s'/s) (x - r):
+//   - distance rate d' = n.(U_B(x_B) - U_A(x_A)) (envelope theorem, unchanged form);
+//   - rate bound over [t0, t1]: |x - r| <= L s(t), so
+//        K = |v_B - v_A| + (|w_A| L_A + |w_B| L_B) max(s(t0), s(t1)) + |s'| (L_A + L_B),
+//     recomputed per step (s grows): the step dt0 = max(d, eps_d) / K(t, t) is shortened to
+//     dt = max(d, eps_d) / K(t, t + dt0), a valid bound on [t, t + dt] since dt <= dt0;
+//   - contact system: with y = R^T (x - r), z = y / s, dz/dt = -R^T U / s, so
+//        df/dt = -grad f_s . U,    d(grad f_s)/dt = w x grad f_s - H_s U - (s'/s) grad f_s
+//     (the last term: the 1/s of grad f_s);
+//   - bounding spheres: |r_AB(t)| <= (L_A + L_B) s(t) + margin, a quadratic inequality in t
+//     with a linearly growing radius (`bounding_sphere_window` with `radius_rate`).
 #pragma once
 #include <Eigen/LU>
 #include <algorithm>
@@ -57,6 +76,36 @@ namespace hb {
 
 enum class ContactStatus { hit, none, failed };
 
+// Common scale factor of both shapes: s(t) = s + rate (t - t_state) (t_state of the input).
+// Must stay positive over the search window.
+struct ScaleLaw {
+  double s = 1.0;
+  double rate = 0.0;  // ds/dt
+  bool active() const { return !(s == 1.0 && rate == 0.0); }
+};
+
+// A shape scaled about its centre by s (models Shape): f_s(y) = f(y / s).
+template <Shape S>
+struct Scaled {
+  S base;
+  double s = 1.0;
+  double f(const Vec3& y) const { return base.f(y / s); }
+  Vec3 grad(const Vec3& y) const { return base.grad(y / s) / s; }
+  Mat3 hessian(const Vec3& y) const { return base.hessian(y / s) / (s * s); }
+  double volume() const { return base.volume() * s * s * s; }
+  double bounding_radius() const { return base.bounding_radius() * s; }
+  double inscribed_radius() const { return base.inscribed_radius() * s; }
+  Vec3 half_extents() const { return base.half_extents() * s; }
+  Vec3 ray_surface(const Vec3& u) const { return base.ray_surface(u) * s; }
+};
+
+// The shape scaled by s. Ellipsoids and spheres scale their semi-axes (same type: the sphere
+// fast path and the closed forms stay available); any other shape is wrapped in Scaled.
+inline Ellipsoid scaled_shape(const Ellipsoid& e, double s) { return Ellipsoid{e.a * s, e.b * s, e.c * s}; }
+inline Sphere scaled_shape(const Sphere& e, double s) { return Sphere{e.radius * s}; }
+template <Shape S>
+Scaled<S> scaled_shape(const S& e, double s) { return Scaled<S>{e, s}; }
+
 template <Shape SA, Shape SB>
 struct ContactInput {
   const SA& shape_a;
@@ -67,6 +116,7 @@ struct ContactInput {
   double t_max = kInf;
   double eps_d = 1e-5;     // the paper's epsilon_d (length units), << min(L_A, L_B)
   DistanceWarmStart warm{};  // previous distance solution of this pair, if any
+  ScaleLaw growth{};         // both shapes scaled by s(t) (growth); default: rigid
 };
 
 struct ContactOptions {
@@ -94,28 +144,50 @@ struct ContactResult {
   DistanceWarmStart warm;       // last distance solution (warm start for the next prediction)
 };
 
-// A body in free flight, coordinates relative to `origin` (to keep the numbers small).
+// A body in free flight, coordinates relative to `origin` (to keep the numbers small),
+// optionally scaled about its centre by s(t) = s0 + sdot (t - t_state).
 template <Shape S>
 struct MovingBody {
   const S* shape;
   BodyState st;
   double t_state;
   Vec3 origin;
+  double s0 = 1.0;    // scale at t_state
+  double sdot = 0.0;  // ds/dt
 
+  double scale_at(double t) const { return s0 + sdot * (t - t_state); }
   Pose pose_at(double t) const {
     return Pose{st.r - origin + st.v * (t - t_state), rotation_at(st, t - t_state)};
   }
-  // f, grad f, Hessian and their time derivatives at the frame point x and time t.
+  // Velocity of the surface point at frame point x (rigid motion + growth), pose p at time t.
+  Vec3 point_velocity(const Vec3& x, const Pose& p, double t) const {
+    const Vec3 rel = x - p.r;
+    if (sdot == 0.0) return st.v + st.w.cross(rel);
+    return st.v + st.w.cross(rel) + (sdot / scale_at(t)) * rel;
+  }
+  // f, grad f, Hessian and their time derivatives at the frame point x and time t (of the
+  // shape at scale s(t); see the header for the growth terms).
   void eval(const Vec3& x, double t, double& f, Vec3& g, Mat3& H, double& ft, Vec3& gt) const {
     const Pose p = pose_at(t);
     const Vec3 rel = x - p.r;
     const Vec3 y = p.R.transpose() * rel;
-    f = shape->f(y);
-    g = p.R * shape->grad(y);
-    H = p.R * shape->hessian(y) * p.R.transpose();
-    const Vec3 u = st.v + st.w.cross(rel);
+    if (sdot == 0.0 && s0 == 1.0) {
+      f = shape->f(y);
+      g = p.R * shape->grad(y);
+      H = p.R * shape->hessian(y) * p.R.transpose();
+      const Vec3 u = st.v + st.w.cross(rel);
+      ft = -g.dot(u);
+      gt = st.w.cross(g) - H * u;
+      return;
+    }
+    const double s = scale_at(t), gr = sdot / s;
+    const Vec3 z = y / s;
+    f = shape->f(z);
+    g = p.R * shape->grad(z) / s;
+    H = p.R * shape->hessian(z) * p.R.transpose() / (s * s);
+    const Vec3 u = st.v + st.w.cross(rel) + gr * rel;
     ft = -g.dot(u);
-    gt = st.w.cross(g) - H * u;
+    gt = st.w.cross(g) - H * u - gr * g;
   }
 };
 
@@ -153,6 +225,61 @@ inline double distance_rate_bound(const BodyState& a, double La, const BodyState
   return (b.v - a.v).norm() + a.w.norm() * La + b.w.norm() * Lb;
 }
 
+// Upper bound of |d'| over [t0, t1] for bodies scaled by law s(t) (growth; see the header).
+inline double distance_rate_bound(const BodyState& a, double La, const BodyState& b, double Lb,
+                                  double s_max, double sdot) {
+  return (b.v - a.v).norm() + (a.w.norm() * La + b.w.norm() * Lb) * s_max +
+         std::abs(sdot) * (La + Lb);
+}
+
+// Time window (absolute) in which the growing bounding spheres overlap, |r_AB(t)| <= R(t),
+// R(t) = R + R_rate (t - t_state) >= 0, intersected with [lo, hi]; false if empty.  With
+// tau = t - t_state:  (|dv|^2 - R_rate^2) tau^2 + 2 (p.dv - R R_rate) tau + |p|^2 - R^2 <= 0
+// and R(tau) >= 0 (the squared inequality also admits the mirror branch |r_AB| <= -R(t)).
+// The true set is an interval (|r_AB(t)| convex, R(t) linear).  Roots are widened by a
+// relative 1e-12 of the window scale so that rounding never cuts a contact off.
+inline bool bounding_sphere_window(const BodyState& a, const BodyState& b, double t_state,
+                                   double R, double R_rate, double& lo, double& hi) {
+  const Vec3 p = b.r - a.r, dv = b.v - a.v;
+  const double A = dv.squaredNorm() - R_rate * R_rate;
+  const double Bh = p.dot(dv) - R * R_rate;
+  const double C = p.squaredNorm() - R * R;
+  double tl = -kInf, th = kInf;  // tau interval
+  if (R_rate > 0.0) tl = -R / R_rate;
+  else if (R_rate < 0.0) th = -R / R_rate;
+  double q1 = -kInf, q2 = kInf;  // the quadratic's solution set, as an interval
+  if (A == 0.0) {  // linear: 2 Bh tau + C <= 0
+    if (Bh > 0.0) q2 = -C / (2.0 * Bh);
+    else if (Bh < 0.0) q1 = -C / (2.0 * Bh);
+    else if (C > 0.0) return false;
+  } else {
+    const double disc = Bh * Bh - A * C;
+    if (disc < 0.0) {
+      if (A > 0.0) return false;  // convex, always positive
+      // concave, always negative: every tau of the R >= 0 branch
+    } else {
+      const double sq = std::sqrt(disc);
+      const double q = -(Bh + std::copysign(sq, Bh));
+      double t1 = q / A, t2 = (q != 0.0) ? C / q : t1;
+      if (t1 > t2) std::swap(t1, t2);
+      const double w = 1e-12 * (std::abs(t1) + std::abs(t2));
+      if (A > 0.0) {
+        q1 = t1 - w, q2 = t2 + w;
+      } else {
+        // concave: (-inf, t1] U [t2, inf); the branch with R >= 0 is the one that is kept
+        if (R_rate > 0.0) q1 = t2 - w;
+        else q2 = t1 + w;
+      }
+    }
+  }
+  tl = std::max(tl, q1);
+  th = std::min(th, q2);
+  if (!(tl <= th)) return false;
+  lo = std::max(lo, t_state + tl);
+  hi = std::min(hi, t_state + th);
+  return lo <= hi;
+}
+
 // Time window (absolute) in which the bounding spheres overlap, intersected with [lo, hi].
 // Returns false if empty.
 inline bool bounding_sphere_window(const BodyState& a, const BodyState& b, double t_state,
@@ -186,25 +313,51 @@ struct Solver {
   ContactResult& out;
   MovingBody<SA> A;
   MovingBody<SB> B;
-  double L;   // length scale: max bounding radius
-  double K;   // distance-rate bound
+  bool grow;  // shapes scaled by in.growth
+  double L;   // length scale: max bounding radius (at the scale of t_start)
+  double K;   // distance-rate bound (with growth: at t_start; steps use rate_bound)
   DistanceWarmStart warm;
+  double warm_scale;  // scale of the shapes at which `warm` was found
   bool failed = false;
 
   Solver(const ContactInput<SA, SB>& i, const ContactOptions& op, ContactResult& r)
       : in(i), o(op), out(r),
-        A{&i.shape_a, i.a, i.t_state, i.a.r},
-        B{&i.shape_b, i.b, i.t_state, i.a.r},
-        L(std::max(i.shape_a.bounding_radius(), i.shape_b.bounding_radius())),
-        K(distance_rate_bound(i.a, i.shape_a.bounding_radius(), i.b,
-                              i.shape_b.bounding_radius())),
-        warm(i.warm) {}
+        A{&i.shape_a, i.a, i.t_state, i.a.r, i.growth.s, i.growth.rate},
+        B{&i.shape_b, i.b, i.t_state, i.a.r, i.growth.s, i.growth.rate},
+        grow(i.growth.active()),
+        L(std::max(i.shape_a.bounding_radius(), i.shape_b.bounding_radius()) *
+          (grow ? A.scale_at(i.t_start) : 1.0)),
+        K(grow ? rate_bound(i.t_start, i.t_start)
+               : distance_rate_bound(i.a, i.shape_a.bounding_radius(), i.b,
+                                     i.shape_b.bounding_radius())),
+        warm(i.warm), warm_scale(grow ? A.scale_at(i.t_start) : 1.0) {}
+
+  // Rate bound over [t0, t1] (growth: the scale is largest at one end).
+  double rate_bound(double t0, double t1) const {
+    if (!grow) return K;
+    return distance_rate_bound(in.a, in.shape_a.bounding_radius(), in.b,
+                               in.shape_b.bounding_radius(),
+                               std::max(A.scale_at(t0), A.scale_at(t1)), in.growth.rate);
+  }
+
+  DistanceResult solve_distance(double t, const Pose& pa, const Pose& pb) {
+    if (!grow)
+      return distance(*A.shape, pa, *B.shape, pb, o.distance, warm.valid ? &warm : nullptr);
+    const double s = A.scale_at(t);
+    if (warm.valid && warm_scale != s) {  // the warm points scale with the shapes
+      warm.xa_body *= s / warm_scale;
+      warm.xb_body *= s / warm_scale;
+    }
+    warm_scale = s;
+    return distance(scaled_shape(*A.shape, s), pa, scaled_shape(*B.shape, s), pb, o.distance,
+                    warm.valid ? &warm : nullptr);
+  }
 
   Sample eval(double t) {
     Sample s;
     s.t = t;
     const Pose pa = A.pose_at(t), pb = B.pose_at(t);
-    s.res = distance(*A.shape, pa, *B.shape, pb, o.distance, warm.valid ? &warm : nullptr);
+    s.res = solve_distance(t, pa, pb);
     ++out.distance_evals;
     out.distance_nr_iterations += s.res.nr_iterations;
     if (s.res.status == DistanceStatus::fallback) ++out.distance_fallbacks;
@@ -215,8 +368,8 @@ struct Solver {
     }
     warm = s.res.warm;
     s.d = s.res.distance;
-    const Vec3 ua = A.st.v + A.st.w.cross(s.res.point_a - pa.r);
-    const Vec3 ub = B.st.v + B.st.w.cross(s.res.point_b - pb.r);
+    const Vec3 ua = A.point_velocity(s.res.point_a, pa, t);
+    const Vec3 ub = B.point_velocity(s.res.point_b, pb, t);
     s.dd = s.res.normal.dot(ub - ua);
     out.min_distance = std::min(out.min_distance, s.d);
     return s;
@@ -299,10 +452,16 @@ struct Solver {
     // the window would end exactly at touching, where the distance is zero up to rounding and
     // a rounding-negative sample would fake a contact.
     const double margin = std::max(in.eps_d, 1e-9 * L);
-    if (!(lo <= hi) ||
-        !bounding_sphere_window(in.a, in.b, in.t_state,
-                                in.shape_a.bounding_radius() + in.shape_b.bounding_radius() + margin,
-                                lo, hi)) {
+    const double Lab = in.shape_a.bounding_radius() + in.shape_b.bounding_radius();
+    if (grow && !(A.scale_at(lo) > 0.0 && (hi == kInf ? in.growth.rate >= 0.0 : A.scale_at(hi) > 0.0))) {
+      failed = true;  // the scale law must stay positive over the window
+      return;
+    }
+    const bool window =
+        grow ? bounding_sphere_window(in.a, in.b, in.t_state, Lab * in.growth.s + margin,
+                                      Lab * in.growth.rate, lo, hi)
+             : bounding_sphere_window(in.a, in.b, in.t_state, Lab + margin, lo, hi);
+    if (!(lo <= hi) || !window) {
       out.status = ContactStatus::none;
       return;
     }
@@ -319,7 +478,14 @@ struct Solver {
         failed = true;
         return;
       }
-      const double dt = std::max(s.d, in.eps_d) / K;
+      double Ks = K;
+      double dt = std::max(s.d, in.eps_d) / K;
+      if (grow) {  // K over [s.t, s.t + dt0], then the (shorter) step that bound allows
+        Ks = rate_bound(s.t, s.t);
+        dt = std::max(s.d, in.eps_d) / Ks;
+        Ks = rate_bound(s.t, s.t + dt);
+        dt = std::max(s.d, in.eps_d) / Ks;
+      }
       const double t1 = std::min(s.t + dt, hi);
       const Sample s1 = eval(t1);
       if (failed) return;
@@ -336,7 +502,7 @@ struct Solver {
           report_hit(s.t, 0.5 * (s.res.point_a + s.res.point_b), s.res.normal);
           return;
         }
-      } else if (s.d + s1.d <= K * (t1 - s.t) && s.dd < 0.0 && s1.dd > 0.0 && s.d > 0.0) {
+      } else if (s.d + s1.d <= Ks * (t1 - s.t) && s.dd < 0.0 && s1.dd > 0.0 && s.d > 0.0) {
         // grazing: a minimum inside [s.t, t1] that may dip below zero
         ++out.grazing_searches;
         Sample neg;
