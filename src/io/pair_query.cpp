@@ -9,13 +9,14 @@
 #include "geometry/distance.hpp"
 #include "io/run.hpp"
 #include "shapes/ellipsoid.hpp"
+#include "shapes/superquadric.hpp"
 
 namespace hb {
 
 namespace {
 
 using json = nlohmann::json;
-using AnyShape = std::variant<Sphere, Ellipsoid>;
+using AnyShape = std::variant<Sphere, Ellipsoid, Superquadric>;
 
 struct Where {
   const std::string& source;
@@ -61,7 +62,13 @@ AnyShape parse_shape(const json& j, const Where& w) {
     if (!(s.minCoeff() > 0.0)) w.fail("shape: every semi-axis must be positive");
     return Ellipsoid{s[0], s[1], s[2]};
   }
-  if (t == "superquadric") w.fail("shape type 'superquadric' is not supported yet");
+  if (t == "superquadric") {
+    const Eigen::VectorXd s = numbers(j, "semi_axes", 3, w);
+    const Eigen::VectorXd e = numbers(j, "exponents", 3, w);
+    if (!(s.minCoeff() > 0.0)) w.fail("shape: every semi-axis must be positive");
+    if (!(e.minCoeff() >= 2.0)) w.fail("shape: every exponent must be >= 2");
+    return Superquadric{s[0], s[1], s[2], e[0], e[1], e[2]};
+  }
   w.fail(fmt::format("unknown shape type '{}'", t));
 }
 

@@ -165,3 +165,16 @@ def test_contact_time_contract(tmp_path):
 def test_pair_queries_bad_input_exit_2(tmp_path, line, expect):
     r = subprocess.run([HB, "distance"], input=line + "\n", capture_output=True, text=True, cwd=tmp_path)
     assert r.returncode == 2 and "<stdin>:1" in r.stderr and expect in r.stderr, r.stderr
+
+
+def test_superquadric_pair_queries(tmp_path):
+    sq = {"type": "superquadric", "semi_axes": [1.0, 0.5, 0.5], "exponents": [8, 8, 8]}
+    sph = {"type": "sphere", "radius": 0.5}
+    r, out = query("distance", [{"a": body(sq, (0, 0, 0)), "b": body(sph, (3, 0, 0))}], tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert abs(out[0]["distance"] - 1.5) < 1e-9
+    r, out = query("contact-time", [{"a": body(sq, (0, 0, 0), v=(0, 0, 0), w=(0, 0, 0)),
+                                     "b": body(sph, (3, 0, 0), v=(-0.5, 0, 0), w=(0, 0, 0)),
+                                     "t_max": 10}], tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert abs(out[0]["time"] - 3.0) < 1e-8
