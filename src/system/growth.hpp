@@ -1,0 +1,270 @@
+// Lubachevsky–Stillinger growth: dense initial states of hard rigid bodies (docs/growth.md).
+//
+// All bodies are scaled about their centres by the common factor s(t) = s0 + g (t - t0) while
+// the event-driven run goes on; at t_stop (s = s_stop, normally 1: the target shape) the
+// growth stops.  The packing fraction is phi(t) = phi_target s(t)^3.
+//
+//  - Contact prediction: the generic contact-time solver with the scale law
+//    (ContactInput::growth; contact/contact_time.hpp derives the growing-shape terms).
+//  - Collision rule: scaling about the centre moves the surface point x of a body with
+//    centre r at (s'/s) (x - r).  At the contact point x_C with normal n (A into B) the
+//    outward normal speed of A's surface is (s'/s) n.(x_C - r_A) and that of B's (outward
+//    normal -n) is -(s'/s) n.(x_C - r_B); their sum is
+//        grow = (s'/s) n.(r_B - r_A) = (s'/s) n.r_AB  (>= 0 for convex bodies containing their
+//    centres), which collision/rigid.hpp's `collide` turns into u'.n = -u.n - 2 grow: the gap
+//    opens after the collision at the rate it closed, and the kinetic energy rises by J grow.
+//  - Thermostat: `grow_bodies` stops the loop every `rescale_interval` of simulated time,
+//    streams every body to that instant, rescales v and w to the translational and rotational
+//    temperature kT, and rebuilds the Simulation (a full re-prediction: new velocities).
+//
+// GrowingRigidBodies<S> is a pair model for Simulation (same interface as RigidBodies).  Its
+// predictions cover [now, t_stop] only (contacts after t_stop are reported as none): a run
+// that continues past t_stop must re-predict every body at t_stop (grow_bodies does: it ends
+// there, and the caller continues with a plain RigidBodies simulation at the target size).
+#pragma once
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+
+#include "collision/rigid.hpp"
+#include "contact/contact_time.hpp"
+#include "geometry/distance.hpp"
+#include "neighbors/cell_neighbors.hpp"
+#include "observers/overlap.hpp"
+#include "system/box.hpp"
+#include "system/rigid_bodies.hpp"
+#include "system/rigid_setup.hpp"
+#include "system/simulation.hpp"
+#include "system/state.hpp"
+
+namespace hb {
+
+// s(t) = s0 + rate (min(t, t_stop) - t0): linear growth until t_stop, constant afterwards.
+struct GrowthLaw {
+  double s0 = 1.0;
+  double rate = 0.0;  // ds/dt (>= 0)
+  double t0 = 0.0;
+  double t_stop = kInf;
+
+  double scale_at(double t) const { return s0 + rate * (std::min(t, t_stop) - t0); }
+  double rate_at(double t) const { return t < t_stop ? rate : 0.0; }
+  double final_scale() const { return t_stop == kInf ? kInf : scale_at(t_stop); }
+};
+
+template <Shape S>
+struct GrowingRigidBodies {
+  static constexpr bool kWindowed = true;  // predictions only up to the next neighbour event
+
+  S shape;  // the shape at scale 1
+  MassProperties mass;
+  GrowthLaw law;
+  double eps_d = 1e-5;
+  ContactOptions options{};
+  mutable SolverStats stats{};
+
+  // Largest centre distance at contact over the whole run: the final size.
+  double interaction_range() const {
+    return 2.0 * shape.bounding_radius() * std::max(law.s0, law.final_scale());
+  }
+  ScaleLaw scale_law(double now) const { return ScaleLaw{law.scale_at(now), law.rate_at(now)}; }
+
+  void contact_times(const State& s, const Box& box, std::uint32_t i, const std::uint32_t* js,
+                     const Vec3* shifts, std::size_t n, double now, double horizon,
+                     double* out) const {
+    const BodyState a = s.body(i);  // body i is at `now`
+    const ScaleLaw sl = scale_law(now);
+    if (now < law.t_stop) horizon = std::min(horizon, law.t_stop);  // the law changes there
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::uint32_t j = js[k];
+      out[k] = kInf;
+      if (j == i) continue;
+      BodyState b = s.body_at(j, now);
+      b.r = shifts ? Vec3(b.r + shifts[k]) : Vec3(a.r + box.near_image(b.r - a.r));
+      ContactInput<S, S> in{shape, shape, a, b, now, now, horizon, eps_d};
+      in.growth = sl;
+      const ContactResult r = contact_time(in, options);
+      ++stats.predictions;
+      stats.distance_evals += r.distance_evals;
+      stats.distance_nr_iterations += r.distance_nr_iterations;
+      stats.contact_nr_iterations += r.nr_iterations;
+      stats.grazing_searches += r.grazing_searches;
+      stats.fallbacks += r.fallbacks;
+      stats.distance_fallbacks += r.distance_fallbacks;
+      if (r.status == ContactStatus::failed)
+        throw SolverFailure(fmt::format(
+            "contact-time solver failed for growing bodies {} and {} at t = {:.17g} (scale "
+            "{:.17g}, rate {:.17g}); reproducer at scale 1: {}",
+            i, j, now, sl.s, sl.rate,
+            RigidBodies<S>{shape, mass, eps_d}.reproducer(a, b, horizon - now)));
+      if (r.status == ContactStatus::hit) out[k] = std::max(0.0, r.time - now);
+    }
+  }
+
+  // Sum of the outward normal speeds of both surfaces at the contact (see the header).
+  static double growth_speed(double s, double sdot, const Vec3& n, const Vec3& r_ab) {
+    return std::max(0.0, (sdot / s) * n.dot(r_ab));
+  }
+
+  CollisionRecord collide(State& s, const Box& box, std::uint32_t i, std::uint32_t j,
+                          double now) const {
+    BodyState a = s.body(i), b = s.body(j);  // both at `now`
+    const double sc = law.scale_at(now), sdot = law.rate_at(now);
+    const auto shp = scaled_shape(shape, sc);
+    const Vec3 r_ab = box.near_image(b.r - a.r);
+    const Pose pa{a.r, a.q.toRotationMatrix()};
+    const Pose pb{Vec3(a.r + r_ab), b.q.toRotationMatrix()};
+    const DistanceResult d = distance(shp, pa, shp, pb, options.distance);
+    if (d.status == DistanceStatus::failed)
+      throw SolverFailure(fmt::format("distance solver failed at the collision of {} and {}", i, j));
+    if (d.status == DistanceStatus::fallback) ++stats.collision_distance_fallbacks;
+    const Vec3 x_c = 0.5 * (d.point_a + d.point_b);
+    const double grow = growth_speed(sc, sdot, d.normal, r_ab);
+    // Grazing contacts (as in RigidBodies): the gap-closing rate u.n + grow is judged here
+    // from the midpoint, by the solver from the closest points; within rounding of zero they
+    // can disagree. Every collision leaves the pair separating at least at eps_v, by raising
+    // the growth term of the impulse rule: with grow' = grow + (eps_v - closing)/2 the gap
+    // opens at -(u'.n + grow) = eps_v.
+    const double un = contact_relative_velocity(a, b, x_c, r_ab).dot(d.normal);
+    const double L = shp.bounding_radius();
+    const double rate = (b.v - a.v).norm() + (a.w.norm() + b.w.norm()) * L + 2.0 * sdot / sc * L;
+    const double eps_v = 1e-8 * rate;
+    const double closing = un + grow;
+    double g_eff = grow;
+    if (closing < eps_v) {
+      g_eff = grow + 0.5 * (eps_v - closing);
+      ++stats.grazing_separations;
+    }
+    CollisionRecord rec = hb::collide(a, mass, b, mass, x_c, d.normal, r_ab, g_eff);
+    s.v[i] = a.v, s.w[i] = a.w;
+    s.v[j] = b.v, s.w[j] = b.w;
+    rec.a = i;
+    rec.b = j;
+    return rec;
+  }
+
+  double kinetic_energy(const State& s) const {
+    double k = 0.0;
+    for (std::size_t i = 0; i < s.size(); ++i) k += hb::kinetic_energy(s.body(i), mass);
+    return k;
+  }
+};
+
+// Translational and rotational kinetic energies of spherical tops.
+inline void rescale_to_temperature(State& s, const MassProperties& mass, double kT) {
+  if (!mass.spherical) throw std::invalid_argument("rescale_to_temperature: spherical tops only");
+  double kt = 0.0, kr = 0.0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    kt += 0.5 * mass.mass * s.v[i].squaredNorm();
+    kr += 0.5 * s.w[i].squaredNorm() / mass.inv_scalar_inertia;
+  }
+  const double target = 1.5 * double(s.size()) * kT;
+  const double ft = kt > 0.0 ? std::sqrt(target / kt) : 1.0;
+  const double fr = kr > 0.0 ? std::sqrt(target / kr) : 1.0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    s.v[i] *= ft;
+    s.w[i] *= fr;
+  }
+}
+
+struct GrowthOptions {
+  double rate = 0.05;              // ds/dt, s relative to the target size (time unit sqrt(m l^2/kT))
+  double phi0 = 0.1;               // packing fraction of the starting lattice (grow_to)
+  double kT = 1.0;                 // thermostat temperature
+  double rescale_interval = 0.5;   // simulated time between velocity rescalings
+};
+
+struct GrowthResult {
+  State state;  // synchronized; time stamps reset to 0 (the start of the continuing run)
+  Box box;
+  double phi = 0.0;         // N v_body / V at the end (the target)
+  double time = 0.0;        // simulated time of the growth
+  double s0 = 1.0;          // initial scale
+  std::uint64_t collisions = 0;
+  std::uint64_t rescales = 0;
+  double heat_removed = 0.0;  // kinetic energy removed by the thermostat (sum)
+  double wall_seconds = 0.0;
+  OverlapReport overlaps;   // independent check of the final state (ellipsoids: grow_to)
+  SolverStats stats;
+};
+
+// Grow bodies of shape `shape` (given at its target size) from `st` (overlap-free at scale s0,
+// positions in `box`) to scale 1 at growth rate opt.rate, rescaling the velocities to opt.kT
+// every opt.rescale_interval.  The state's time stamps are taken as the start time 0.  The
+// result holds the synchronized state at the end of the growth, time stamps reset to 0
+// (no overlap check here: see grow_to).
+template <Shape S>
+GrowthResult grow_bodies(const S& shape, const MassProperties& mass, State st, const Box& box,
+                         double s0, const GrowthOptions& opt, double eps_d = 1e-5) {
+  if (!(s0 > 0.0 && s0 <= 1.0)) throw std::invalid_argument("grow_bodies: need 0 < s0 <= 1");
+  if (!(opt.rate > 0.0) || !std::isfinite(opt.rate))
+    throw std::invalid_argument("grow_bodies: the growth rate must be > 0");
+  if (!(opt.rescale_interval > 0.0))
+    throw std::invalid_argument("grow_bodies: rescale_interval must be > 0");
+  const auto t_wall = std::chrono::steady_clock::now();
+  GrowthResult res;
+  res.box = box;
+  res.s0 = s0;
+  const double t_stop = (1.0 - s0) / opt.rate;
+  GrowingRigidBodies<S> model{shape, mass, GrowthLaw{s0, opt.rate, 0.0, t_stop}, eps_d};
+  for (std::size_t i = 0; i < st.size(); ++i) st.t[i] = 0.0;
+  rescale_to_temperature(st, mass, opt.kT);
+  double t = 0.0;
+  while (t < t_stop) {
+    const double t_next = std::min(t + opt.rescale_interval, t_stop);
+    using Sim = Simulation<GrowingRigidBodies<S>, CellNeighbors>;
+    const double range = model.interaction_range();
+    Sim sim(box, std::move(st), std::move(model), CellNeighbors(range), t);
+    while (sim.step(t_next).type != EventType::None) {
+    }
+    sim.synchronize();
+    res.collisions += sim.collisions();
+    st = sim.state();
+    model = sim.model();
+    t = t_next;
+    const double k_before = model.kinetic_energy(st);
+    rescale_to_temperature(st, mass, opt.kT);
+    res.heat_removed += k_before - model.kinetic_energy(st);
+    ++res.rescales;
+  }
+  res.time = t;
+  res.stats = model.stats;
+  for (std::size_t i = 0; i < st.size(); ++i) st.t[i] = 0.0;  // time 0 of the continuing run
+  res.state = std::move(st);
+  res.phi = double(res.state.size()) * shape.volume() / box.volume();
+  res.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t_wall).count();
+  return res;
+}
+
+// Dense ellipsoid state: the stretched FCC lattice of rigid_setup.hpp at opt.phi0 (aligned
+// bodies, Maxwell–Boltzmann velocities and spins from spec.seed), shrunk as a whole by
+// s0 = (phi0 / spec.phi)^(1/3) so that target-size bodies fill spec.phi of the box, then
+// grown to s = 1 (phi = spec.phi).  The final state is checked with the Perram–Wertheim
+// contact function; an overlap throws std::runtime_error.
+inline GrowthResult grow_to(const RigidSystemSpec& spec, const GrowthOptions& opt = {}) {
+  if (!(spec.phi > 0.0) || !(opt.phi0 > 0.0) || opt.phi0 > spec.phi)
+    throw std::invalid_argument("grow_to: need 0 < phi0 <= phi (target)");
+  RigidSystemSpec start = spec;
+  start.phi = opt.phi0;
+  Box box;
+  State st = ellipsoid_start(start, box);
+  const double s0 = std::cbrt(opt.phi0 / spec.phi);
+  box.L *= s0;
+  for (auto& r : st.r) r *= s0;
+  const Ellipsoid shape{spec.semi_axes.x(), spec.semi_axes.y(), spec.semi_axes.z()};
+  GrowthResult res = grow_bodies(shape, MassProperties::spherical_top(spec.mass, spec.inertia),
+                                 std::move(st), box, s0, opt, spec.eps_d);
+  res.overlaps = ellipsoid_overlaps(res.state.r, res.state.q, res.box, spec.semi_axes);
+  if (res.overlaps.overlaps != 0)
+    throw std::runtime_error(fmt::format("grow_to: {} overlapping pairs in the grown state "
+                                         "(min gap {:.3e}, seed {})",
+                                         res.overlaps.overlaps, res.overlaps.min_distance,
+                                         spec.seed));
+  return res;
+}
+
+}  // namespace hb
