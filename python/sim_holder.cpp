@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "io/checkpoint.hpp"
+#include "io/plan.hpp"
 #include "system/init.hpp"
 #include "system/rigid_setup.hpp"
 #include "system/sphere_setup.hpp"
@@ -61,25 +62,8 @@ std::unique_ptr<SimHandle> hold(Sim sim, double mass, K kinetic, O overlaps) {
   return std::make_unique<Holder<Sim, K, O>>(std::move(sim), mass, kinetic, overlaps);
 }
 
-// The run driver's box-size rule (src/io/run.cpp, plan_*): at least two interaction ranges.
-void require_box(const Config& c, double side, double range) {
-  if (side < 2.0 * range)
-    throw ConfigError(fmt::format(
-        "{}: key 'system.particles': {} particles at packing fraction {} give a box side of "
-        "{:.3g}, less than two interaction ranges ({:.3g}); use more particles",
-        c.source, c.particles, c.packing_fraction, side, 2.0 * range));
-}
-
 std::unique_ptr<SimHandle> spheres(const Config& c) {
-  SphereSystemSpec spec;
-  spec.n = c.particles;
-  spec.phi = c.packing_fraction;
-  spec.sigma = 2.0 * c.shape.radius;
-  spec.mass = c.mass;
-  spec.kT = c.temperature;
-  spec.seed = c.seed;
-  spec.shell = c.neighbors_method == "nnl" ? c.shell : 0.0;
-  require_box(c, cubic_box_for(spec.n, c.shape.volume(), spec.phi).L.x(), spec.sigma + spec.shell);
+  const SphereSystemSpec spec = plan_spheres(c);  // the run driver's checks and messages
   auto kinetic = [m = spec.mass](const State& s) { return hb::kinetic_energy(s, m); };
   auto overlaps = [sigma = spec.sigma](const State& s, const Box& b) {
     return sphere_overlaps(s.r, b, sigma);
@@ -90,19 +74,7 @@ std::unique_ptr<SimHandle> spheres(const Config& c) {
 }
 
 std::unique_ptr<SimHandle> ellipsoids(const Config& c) {
-  RigidSystemSpec spec;
-  spec.n = c.particles;
-  spec.phi = c.packing_fraction;
-  spec.semi_axes = c.shape.semi_axes;
-  spec.mass = c.mass;
-  spec.inertia = c.shape.inertia;
-  spec.kT = c.temperature;
-  spec.seed = c.seed;
-  spec.eps_d = c.eps_d;
-  // The box side follows from the lattice ellipsoid_start builds; it checks the density itself.
-  Box box;
-  (void)ellipsoid_start(spec, box);
-  require_box(c, box.L.minCoeff(), 2.0 * spec.semi_axes.maxCoeff());
+  const RigidSystemSpec spec = plan_ellipsoids(c);
   const auto proto = ellipsoid_model(spec);
   auto kinetic = [proto](const State& s) { return proto.kinetic_energy(s); };
   auto overlaps = [axes = spec.semi_axes](const State& s, const Box& b) {

@@ -16,6 +16,7 @@
 #include "io/config.hpp"
 #include "io/files.hpp"
 #include "io/gsd_hoomd.hpp"
+#include "io/plan.hpp"
 #include "io/progress.hpp"
 #include "observers/correlations.hpp"
 #include "observers/overlap.hpp"
@@ -68,32 +69,6 @@ nlohmann::json shape_json(const ShapeSpec& s) {
     if (s.type == "superquadric") j["exponents"] = {s.exponents.x(), s.exponents.y(), s.exponents.z()};
   }
   return j;
-}
-
-// Everything a hard-sphere run needs, checked before any file is written.
-SphereSystemSpec plan_spheres(const Config& c) {
-  SphereSystemSpec p;
-  p.n = c.particles;
-  p.phi = c.packing_fraction;
-  p.sigma = 2.0 * c.shape.radius;
-  p.mass = c.mass;
-  p.kT = c.temperature;
-  p.seed = c.seed;
-  p.shell = c.neighbors_method == "nnl" ? c.shell : 0.0;
-  const Box box = cubic_box_for(c.particles, c.shape.volume(), c.packing_fraction);
-  const double phi_max = fcc_max_packing_fraction(c.particles);
-  if (c.packing_fraction > phi_max * (1.0 - 1e-12))
-    throw ConfigError(fmt::format(
-        "{}: key 'system.packing_fraction': {} is too dense for an FCC start with {} particles "
-        "(at most {:.4f}; use N = 4 m^3 for up to 0.74)",
-        c.source, c.packing_fraction, c.particles, phi_max));
-  const double reach = p.sigma + p.shell;
-  if (box.L.minCoeff() < 2.0 * reach)
-    throw ConfigError(fmt::format(
-        "{}: key 'system.particles': {} particles at packing fraction {} give a box of side "
-        "{:.3g}, less than two interaction ranges ({:.3g}); use more particles",
-        c.source, c.particles, c.packing_fraction, box.L.x(), 2.0 * reach));
-  return p;
 }
 
 // Rows of log.tsv, kept in log.tsv.part while running and renamed at the end.
@@ -500,6 +475,34 @@ void start_or_resume(const Config& cfg, const RunOptions& opt, const std::string
   drive(cfg, opt, dir, sim, DriverState{}, ops);
 }
 
+}  // namespace
+
+// Everything a hard-sphere run needs, checked before any file is written.
+SphereSystemSpec plan_spheres(const Config& c) {
+  SphereSystemSpec p;
+  p.n = c.particles;
+  p.phi = c.packing_fraction;
+  p.sigma = 2.0 * c.shape.radius;
+  p.mass = c.mass;
+  p.kT = c.temperature;
+  p.seed = c.seed;
+  p.shell = c.neighbors_method == "nnl" ? c.shell : 0.0;
+  const Box box = cubic_box_for(c.particles, c.shape.volume(), c.packing_fraction);
+  const double phi_max = fcc_max_packing_fraction(c.particles);
+  if (c.packing_fraction > phi_max * (1.0 - 1e-12))
+    throw ConfigError(fmt::format(
+        "{}: key 'system.packing_fraction': {} is too dense for an FCC start with {} particles "
+        "(at most {:.4f}; use N = 4 m^3 for up to 0.74)",
+        c.source, c.packing_fraction, c.particles, phi_max));
+  const double reach = p.sigma + p.shell;
+  if (box.L.minCoeff() < 2.0 * reach)
+    throw ConfigError(fmt::format(
+        "{}: key 'system.particles': {} particles at packing fraction {} give a box of side "
+        "{:.3g}, less than two interaction ranges ({:.3g}); use more particles",
+        c.source, c.particles, c.packing_fraction, box.L.x(), 2.0 * reach));
+  return p;
+}
+
 RigidSystemSpec plan_ellipsoids(const Config& c) {
   RigidSystemSpec p;
   p.n = c.particles;
@@ -527,8 +530,6 @@ RigidSystemSpec plan_ellipsoids(const Config& c) {
         c.source, c.particles, c.packing_fraction, L.minCoeff(), 2.0 * range));
   return p;
 }
-
-}  // namespace
 
 void run_simulation(const RunOptions& opt) {
   const Config cfg = load_config(opt.config_path, opt.overrides);
