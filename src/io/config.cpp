@@ -43,6 +43,7 @@ const std::map<std::string, std::map<std::string, Kind>>& schema() {
       {"output",
        {{"log_interval", Kind::Float}, {"snapshot_interval", Kind::Float},
         {"checkpoint_interval", Kind::Float}, {"trajectory", Kind::Bool}}},
+      {"init", {{"method", Kind::String}, {"phi0", Kind::Float}, {"growth_rate", Kind::Float}}},
       {"observables",
        {{"interval", Kind::Float}, {"origin_every", Kind::Int}, {"max_lag", Kind::Float},
         {"q", Kind::Float}, {"q_vectors", Kind::Int}, {"gr_interval", Kind::Float},
@@ -207,6 +208,9 @@ Config validate(const std::string& file, const toml::table& root) {
   r.real("output", "snapshot_interval", c.snapshot_interval);
   r.real("output", "checkpoint_interval", c.checkpoint_interval);
   r.boolean("output", "trajectory", c.trajectory);
+  r.string("init", "method", c.init_method);
+  r.real("init", "phi0", c.init_phi0);
+  r.real("init", "growth_rate", c.init_growth_rate);
   r.real("observables", "interval", c.obs_interval);
   r.integer("observables", "origin_every", c.obs_origin_every);
   r.real("observables", "max_lag", c.obs_max_lag);
@@ -274,6 +278,10 @@ Config validate(const std::string& file, const toml::table& root) {
   if (!(c.log_interval > 0.0)) bad("output", "log_interval", "must be positive");
   if (!(c.snapshot_interval > 0.0)) bad("output", "snapshot_interval", "must be positive");
   if (!(c.checkpoint_interval > 0.0)) bad("output", "checkpoint_interval", "must be positive");
+  if (c.init_method != "grow" && c.init_method != "lattice")
+    bad("init", "method", fmt::format("must be \"grow\" or \"lattice\" (got \"{}\")", c.init_method));
+  if (!(c.init_phi0 > 0.0 && c.init_phi0 < 0.5)) bad("init", "phi0", "must be in (0, 0.5)");
+  if (!(c.init_growth_rate > 0.0)) bad("init", "growth_rate", "must be positive");
   if (c.obs_interval < 0.0) bad("observables", "interval", "must not be negative (0 switches it off)");
   if (c.obs_origin_every < 1) bad("observables", "origin_every", "must be at least 1");
   if (c.obs_interval > 0.0 && !(c.obs_max_lag >= c.obs_interval))
@@ -344,6 +352,11 @@ std::string to_toml(const Config& c) {
                                   {"gr_interval", c.gr_interval},
                                   {"gr_bins", int64_t(c.gr_bins)}}},
   };
+  toml::table init;
+  init.insert("method", c.init_method);
+  init.insert("phi0", c.init_phi0);
+  init.insert("growth_rate", c.init_growth_rate);
+  root.insert("init", init);
   std::ostringstream os;
   os << "# hardbody resolved configuration (every key, defaults filled in)\n" << root << "\n";
   return os.str();

@@ -50,6 +50,10 @@ struct Config {
   double snapshot_interval = 10.0;
   double checkpoint_interval = 600.0;  // wall seconds
   bool trajectory = true;
+  // [init]  dense starts of non-spherical bodies
+  std::string init_method = "grow";  // "grow" (Lubachevsky–Stillinger from init.phi0) | "lattice"
+  double init_phi0 = 0.1;            // packing fraction of the dilute lattice that is grown
+  double init_growth_rate = 0.05;    // d(scale)/dt of the growth
   // [observables]
   double obs_interval = 0.1;     // sampling interval of MSD, C2, F_self (0: off)
   std::uint64_t obs_origin_every = 10;

@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <functional>
+#include <memory>
 #include <csignal>
 #include <ctime>
 #include <filesystem>
@@ -23,6 +24,7 @@
 #include "observers/structure.hpp"
 #include "observers/thermo.hpp"
 #include "system/init.hpp"
+#include "system/growth.hpp"
 #include "system/rigid_setup.hpp"
 #include "system/sphere_setup.hpp"
 
@@ -135,6 +137,7 @@ void truncate_trajectory(const std::string& path, std::uint64_t frames) {
 struct SystemOps {
   std::function<double(const State&)> kinetic;  // total kinetic energy (translation + rotation)
   std::function<OverlapReport(const State&, const Box&)> overlaps;  // independent check, synced state
+  std::shared_ptr<nlohmann::json> extra = std::make_shared<nlohmann::json>(nlohmann::json::object());  // merged into summary.json
 };
 
 class Interrupted : public std::runtime_error {
@@ -389,6 +392,7 @@ class Driver {
     }
     if (cfg_.gr_interval > 0.0) write_file_atomic(dir_ + "/gr.tsv", rdf_.to_tsv());
     write_file_atomic(dir_ + "/nematic.tsv", nem_.to_tsv());
+    for (const auto& [k, v] : ops_.extra->items()) j[k] = v;
     log.commit();
     write_file_atomic(dir_ + "/summary.json", j.dump(2) + "\n");
     if (!opt_.quiet)
@@ -514,7 +518,11 @@ RigidSystemSpec plan_ellipsoids(const Config& c) {
   p.seed = c.seed;
   p.eps_d = c.eps_d;
   const StretchedLattice lat = stretched_lattice(c.particles, c.shape.semi_axes);
-  if (c.packing_fraction > lat.phi_max * (1.0 - 1e-12))
+  const bool grow = c.init_method == "grow" && c.packing_fraction > c.init_phi0;
+  if (grow && c.init_phi0 > lat.phi_max * (1.0 - 1e-12))
+    throw ConfigError(fmt::format("{}: key 'init.phi0': {} is too dense for the lattice start",
+                                  c.source, c.init_phi0));
+  if (!grow && c.packing_fraction > lat.phi_max * (1.0 - 1e-12))
     throw ConfigError(fmt::format(
         "{}: key 'system.packing_fraction': {} is too dense for the lattice start with {} "
         "particles (at most {:.4f})", c.source, c.packing_fraction, c.particles, lat.phi_max));
@@ -556,14 +564,48 @@ void run_simulation(const RunOptions& opt) {
                           [axes = spec.semi_axes](const State& s, const Box& b) {
                             return ellipsoid_overlaps(s.r, s.q, b, axes);
                           }};
+      // The initial state: the stretched lattice at the target density, or (init.method =
+      // "grow", above init.phi0) a dilute lattice grown Lubachevsky–Stillinger style.
+      const bool grow = cfg.init_method == "grow" && cfg.packing_fraction > cfg.init_phi0;
+      auto start = [&](Box& box) {
+        if (!grow) return ellipsoid_start(spec, box);
+        GrowthOptions go;
+        go.rate = cfg.init_growth_rate;
+        go.phi0 = cfg.init_phi0;
+        go.kT = cfg.temperature;
+        if (!opt.quiet)
+          std::fprintf(stderr, "hardbody: growing from phi = %g to %g (rate %g) ...\n", go.phi0,
+                       cfg.packing_fraction, go.rate);
+        GrowthResult g = grow_to(spec, go);
+        (*ops.extra)["init"] = {{"method", "grow"}, {"phi0", go.phi0}, {"growth_rate", go.rate},
+                                {"growth_time", g.time}, {"growth_collisions", g.collisions},
+                                {"growth_wall_seconds", g.wall_seconds},
+                                {"growth_velocity_rescales", g.rescales},
+                                {"min_distance_after_growth", g.overlaps.min_distance}};
+        box = g.box;
+        return std::move(g.state);
+      };
+      if (!grow) (*ops.extra)["init"] = {{"method", "lattice"}};
       if (cfg.neighbors_method == "nnl")
         start_or_resume<EllipsoidListSim>(
-            cfg, opt, dir, [&] { return make_ellipsoid_list_simulation(spec, cfg.shell); },
+            cfg, opt, dir,
+            [&] {
+              Box box;
+              State st = start(box);
+              return EllipsoidListSim(box, std::move(st), ellipsoid_model(spec),
+                                      ObbNeighbors<Ellipsoid>(proto.shape, cfg.shell));
+            },
             [&] { return ellipsoid_model(spec); }, ObbNeighbors<Ellipsoid>(proto.shape, cfg.shell), ops);
       else
-        start_or_resume<EllipsoidCellSim>(cfg, opt, dir, [&] { return make_ellipsoid_cell_simulation(spec); },
-                                          [&] { return ellipsoid_model(spec); },
-                                          CellNeighbors(proto.interaction_range()), ops);
+        start_or_resume<EllipsoidCellSim>(
+            cfg, opt, dir,
+            [&] {
+              Box box;
+              State st = start(box);
+              return EllipsoidCellSim(box, std::move(st), ellipsoid_model(spec),
+                                      CellNeighbors(proto.interaction_range()));
+            },
+            [&] { return ellipsoid_model(spec); }, CellNeighbors(proto.interaction_range()), ops);
     } else {
       throw ConfigError(fmt::format("{}: key 'shape.type': '{}' bodies are not yet supported by "
                                     "`hardbody run`", cfg.source, cfg.shape.type));

@@ -93,6 +93,8 @@ TEST(Config, BadInputNamesTheProblem) {
       {"unknown shape", replace(g, "\"sphere\"", "\"cube\""), "unknown shape type 'cube'"},
       {"time zero", replace(g, "time = 2.0", "time = 0.0"), "run.time"},
       {"method", g + "[neighbors]\nmethod = \"verlet\"\n", "neighbors.method"},
+      {"init method", g + "[init]\nmethod = \"random\"\n", "init.method"},
+      {"init phi0", g + "[init]\nphi0 = 0.9\n", "init.phi0"},
       {"ellipsoid without axes", replace(g, "type = \"sphere\"\nradius = 0.5", "type = \"ellipsoid\""),
        "shape.semi_axes"},
       {"ellipsoid negative axis",

@@ -20,7 +20,7 @@ std::string ellipsoid_config(int n, double phi, double a, double b, double teq, 
          "\n[shape]\ntype = \"ellipsoid\"\nsemi_axes = [" + std::to_string(a) + ", " +
          std::to_string(b) + ", " + std::to_string(b) + "]\n[run]\nequilibrate_time = " +
          std::to_string(teq) + "\ntime = " + std::to_string(t) +
-         "\n[neighbors]\nmethod = \"cells\"\n[output]\nlog_interval = " +
+         "\n[neighbors]\nmethod = \"cells\"\n[init]\nmethod = \"lattice\"\n[output]\nlog_interval = " +
          std::to_string(log_interval) + "\n[observables]\ninterval = 0.0\ngr_interval = 0.0\n";
 }
 
