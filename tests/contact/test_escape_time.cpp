@@ -194,7 +194,7 @@ void report(const char* name, const Stats& s, long min_escapes) {
 TEST(EscapeTime, AgreesWithConservativeAdvancementReference) {
   testing::Rng r(987654321);
   Stats st;
-  for (int k = 0; k < 10000; ++k) {
+  for (int k = 0; k < hb::testing::scaled_count(10000, 0.03); ++k) {
     Case c;
     c.e = r.ellipsoid(10.0);
     c.s.r = r.ball(5.0);
@@ -218,7 +218,7 @@ TEST(EscapeTime, AgreesWithConservativeAdvancementReference) {
     c.t_max = c.t_start + ((k % 7 == 0) ? r.uni(0.0, 1.0) * shell / K : 40.0 * (shell + 2.0) / K);
     compare(c, (k % 3 == 0) ? r.uni(-1.0, 1.0) : 0.0, st);
   }
-  report("random", st, 8000);
+  report("random", st, hb::testing::scaled_count(10000, 0.03) * 8 / 10);
 }
 
 // Grazing: a spinning body (slow tangential drift) whose distance to one face has a minimum of
@@ -243,7 +243,7 @@ TEST(EscapeTime, GrazingExitsAndNearMisses) {
     c.t_max = 0.99 * period;
     RefEscape ref{c.e, c.s, c.box, c.margin};
     // minimum of d_f over the window: dense scan, then Brent
-    const int m = 4000;
+    const int m = hb::testing::scaled_count(4000, 0.05);
     int jmin = 0;
     double dmin = kInf;
     for (int j = 0; j <= m; ++j) {

@@ -102,7 +102,7 @@ TEST(Obb, SatAgreesWithEdgeClippingBruteForce) {
   const Vec3 L(7.0, 8.0, 9.0);
   Tally crossed, nested, parallel, touching, touching_parallel;
   // 1. crossed: random orientations and centres (about half overlap), with periodic shifts
-  for (int k = 0; k < 60000; ++k) {
+  for (int k = 0; k < hb::testing::scaled_count(60000, 0.03); ++k) {
     Obb a = random_box(r), b = random_box(r);
     a.centre = r.ball(2.0);
     b.centre = r.ball(2.0);
@@ -117,7 +117,7 @@ TEST(Obb, SatAgreesWithEdgeClippingBruteForce) {
     EXPECT_EQ(obb_overlap(a, b, s), obb_overlap(b, a, Vec3(-s)));  // symmetric
   }
   // 2. nested: b strictly inside a (no edge crossings at all: only vertex containment)
-  for (int k = 0; k < 10000; ++k) {
+  for (int k = 0; k < hb::testing::scaled_count(10000, 0.03); ++k) {
     Obb a = random_box(r, 3.0), b;
     b.axes = r.rotation();
     b.half = a.half.minCoeff() * Vec3(r.uni(0.01, 0.5), r.uni(0.01, 0.5), r.uni(0.01, 0.5));
@@ -128,7 +128,7 @@ TEST(Obb, SatAgreesWithEdgeClippingBruteForce) {
     nested.add(obb_overlap(b, a, Vec3::Zero()), brute_overlap(b, a, Vec3::Zero()));
   }
   // 3. near-parallel: b's axes are a's tilted by 1e-12 .. 1e-3 (cross axes nearly degenerate)
-  for (int k = 0; k < 20000; ++k) {
+  for (int k = 0; k < hb::testing::scaled_count(20000, 0.03); ++k) {
     Obb a = random_box(r), b = random_box(r);
     b.axes = tilt(r, r.log_uni(1e-12, 1e-3)) * a.axes;
     if (k % 2) b.axes.col(0).swap(b.axes.col(1));  // also parallel but permuted
@@ -151,8 +151,8 @@ TEST(Obb, SatAgreesWithEdgeClippingBruteForce) {
       t.add(obb_overlap(a, b, Vec3::Zero()), brute_overlap(a, b, Vec3::Zero()));
     }
   };
-  for (int k = 0; k < 10000; ++k) touch_pair(random_box(r), random_box(r), touching);
-  for (int k = 0; k < 10000; ++k) {
+  for (int k = 0; k < hb::testing::scaled_count(10000, 0.03); ++k) touch_pair(random_box(r), random_box(r), touching);
+  for (int k = 0; k < hb::testing::scaled_count(10000, 0.03); ++k) {
     Obb a = random_box(r), b = random_box(r);
     b.axes = tilt(r, r.log_uni(1e-12, 1e-3)) * a.axes;
     touch_pair(a, b, touching_parallel);
@@ -168,7 +168,7 @@ TEST(Obb, SatAgreesWithEdgeClippingBruteForce) {
     EXPECT_EQ(t.false_overlap, 0) << name;
     total += t.pairs;
   }
-  EXPECT_GE(total, 100000);
+  EXPECT_GE(total, hb::testing::scaled_count(100000, 0.03));  // 140,000 pairs in Release
   EXPECT_GT(touching.overlap, 0);
   EXPECT_LT(touching.overlap, touching.pairs);
 }
