@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "io/checkpoint.hpp"
 #include "io/config.hpp"
 #include "io/pair_query.hpp"
 #include "io/run.hpp"
@@ -107,6 +108,9 @@ class Simulation {
  public:
   explicit Simulation(Config c)
       : cfg_(std::move(c)), sim_(hb::python::make_simulation(cfg_)), block_start_(sim_->now()) {}
+  Simulation(Config c, const hb::Box& box, const hb::State& start)
+      : cfg_(std::move(c)), sim_(hb::python::make_simulation(cfg_, box, start)),
+        block_start_(sim_->now()) {}
 
   // Advances by `time`, to the absolute time `until`, and/or by `collisions` real collisions,
   // whichever comes first; stops exactly at the time limit. Pressure blocks are
@@ -293,6 +297,19 @@ PYBIND11_MODULE(hardbody, m) {
              return std::make_unique<Sim>(config_from(config, as_overrides(overrides)));
            }),
            py::arg("config"), py::arg("overrides") = py::none())
+      .def_static("from_gsd",
+                  [](const std::string& path, const py::object& config, long frame,
+                     std::optional<std::vector<std::string>> overrides) {
+                    hb::Config c = config_from(config, as_overrides(overrides));
+                    hb::Box box;
+                    const hb::State st = hb::state_from_gsd(path, frame, box);
+                    return std::make_unique<Sim>(std::move(c), box, st);
+                  },
+                  py::arg("path"), py::arg("config"), py::arg("frame") = -1,
+                  py::arg("overrides") = py::none(),
+                  "Builds a simulation from the bodies of a GSD frame (trajectory.gsd or "
+                  "checkpoint.gsd; exact doubles when present) with the physics of `config`; "
+                  "time starts at 0. The frame must match system.particles and be overlap-free.")
       .def_static("from_toml",
                   [](const std::string& text, std::optional<std::vector<std::string>> overrides) {
                     return std::make_unique<Sim>(hb::parse_config(text, "config text", as_overrides(overrides)));

@@ -62,24 +62,41 @@ std::unique_ptr<SimHandle> hold(Sim sim, double mass, K kinetic, O overlaps) {
   return std::make_unique<Holder<Sim, K, O>>(std::move(sim), mass, kinetic, overlaps);
 }
 
-std::unique_ptr<SimHandle> spheres(const Config& c) {
+std::unique_ptr<SimHandle> spheres(const Config& c, const Box* box, const State* start) {
   const SphereSystemSpec spec = plan_spheres(c);  // the run driver's checks and messages
   auto kinetic = [m = spec.mass](const State& s) { return hb::kinetic_energy(s, m); };
   auto overlaps = [sigma = spec.sigma](const State& s, const Box& b) {
     return sphere_overlaps(s.r, b, sigma);
   };
+  if (start) {
+    const HardSpheres model{spec.sigma, spec.mass};
+    if (spec.shell > 0.0)
+      return hold(SphereListSim(*box, *start, model, ShellNeighbors(spec.sigma, spec.shell)),
+                  spec.mass, kinetic, overlaps);
+    return hold(SphereCellSim(*box, *start, model, CellNeighbors(spec.sigma)), spec.mass, kinetic,
+                overlaps);
+  }
   if (spec.shell > 0.0)
     return hold(make_hard_sphere_list_simulation(spec), spec.mass, kinetic, overlaps);
   return hold(make_hard_sphere_cell_simulation(spec), spec.mass, kinetic, overlaps);
 }
 
-std::unique_ptr<SimHandle> ellipsoids(const Config& c) {
+std::unique_ptr<SimHandle> ellipsoids(const Config& c, const Box* box, const State* start) {
   const RigidSystemSpec spec = plan_ellipsoids(c);
   const auto proto = ellipsoid_model(spec);
   auto kinetic = [proto](const State& s) { return proto.kinetic_energy(s); };
   auto overlaps = [axes = spec.semi_axes](const State& s, const Box& b) {
     return ellipsoid_overlaps(s.r, s.q, b, axes);
   };
+  if (start) {
+    if (c.neighbors_method == "nnl")
+      return hold(EllipsoidListSim(*box, *start, ellipsoid_model(spec),
+                                   ObbNeighbors<Ellipsoid>(proto.shape, c.shell)),
+                  spec.mass, kinetic, overlaps);
+    return hold(EllipsoidCellSim(*box, *start, ellipsoid_model(spec),
+                                 CellNeighbors(proto.interaction_range())),
+                spec.mass, kinetic, overlaps);
+  }
   if (c.neighbors_method == "nnl")
     return hold(make_ellipsoid_list_simulation(spec, c.shell), spec.mass, kinetic, overlaps);
   return hold(make_ellipsoid_cell_simulation(spec), spec.mass, kinetic, overlaps);
@@ -87,16 +104,31 @@ std::unique_ptr<SimHandle> ellipsoids(const Config& c) {
 
 }  // namespace
 
-std::unique_ptr<SimHandle> make_simulation(const Config& c) {
+namespace {
+std::unique_ptr<SimHandle> build(const Config& c, const Box* box, const State* start) {
   try {
-    if (c.shape.type == "sphere") return spheres(c);
-    if (c.shape.type == "ellipsoid") return ellipsoids(c);
+    if (c.shape.type == "sphere") return spheres(c, box, start);
+    if (c.shape.type == "ellipsoid") return ellipsoids(c, box, start);
   } catch (const std::invalid_argument& e) {  // the lattice starts reject a too dense system
     throw ConfigError(fmt::format("{}: key 'system.packing_fraction': {} ({} particles at {})",
                                   c.source, e.what(), c.particles, c.packing_fraction));
   }
   throw ConfigError(fmt::format("{}: key 'shape.type': '{}' bodies are not yet supported", c.source,
                                 c.shape.type));
+}
+}  // namespace
+
+std::unique_ptr<SimHandle> make_simulation(const Config& c) { return build(c, nullptr, nullptr); }
+
+std::unique_ptr<SimHandle> make_simulation(const Config& c, const Box& box, const State& start) {
+  if (start.size() != c.particles)
+    throw ConfigError(fmt::format("{}: key 'system.particles': {} in the config, {} bodies given",
+                                  c.source, c.particles, start.size()));
+  auto h = build(c, &box, &start);
+  const OverlapReport rep = h->overlaps();
+  if (rep.overlaps > 0)
+    throw InputError(fmt::format("the given bodies overlap ({} pairs)", rep.overlaps));
+  return h;
 }
 
 }  // namespace hb::python

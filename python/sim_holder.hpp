@@ -44,5 +44,8 @@ class SimHandle {
 // Builds the simulation a Config describes (as `hardbody run` does, from t = 0; nothing is
 // written). Throws ConfigError for a config the run driver would reject.
 std::unique_ptr<SimHandle> make_simulation(const Config& c);
+// The same, from given bodies and box (e.g. a GSD frame) instead of the lattice start; the
+// number of bodies must match the config. Throws ConfigError / InputError.
+std::unique_ptr<SimHandle> make_simulation(const Config& c, const Box& box, const State& start);
 
 }  // namespace hb::python

@@ -95,6 +95,11 @@ gsd::HoomdFrame make_checkpoint(const Sim& sim, const ShapeSpec& shape, const Co
   return f;
 }
 
+// The bodies of one GSD frame (hardbody's exact log chunks when present, else the HOOMD float
+// chunks; HOOMD positions are in a box centred on 0) as a State at time 0, and its box.
+// frame < 0 counts from the end. Throws InputError naming the file.
+State state_from_gsd(const std::string& path, long frame, Box& box);
+
 template <class Nb>
 struct Restored {
   Box box;

@@ -1,6 +1,8 @@
 """hardbody.Simulation: building from a config, running, state arrays, observables, errors."""
 
+import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -227,3 +229,37 @@ def test_other_bad_input():
     with pytest.raises(ValueError):
         sim.run(until=0.5)
     assert sim.time == 1.0
+
+
+def test_from_gsd_continues_from_a_trajectory_frame(tmp_path):
+    import subprocess
+    import os
+    hb_bin = Path(__file__).resolve().parents[2] / "build" / "apps" / "hardbody" / "hardbody"
+    cfg = {"system": {"particles": 108, "packing_fraction": 0.3, "seed": 5},
+           "shape": {"type": "sphere", "radius": 0.5},
+           "run": {"equilibrate_time": 0.0, "time": 2.0},
+           "output": {"log_interval": 0.5, "snapshot_interval": 1.0}}
+    toml = tmp_path / "c.toml"
+    toml.write_text("\n".join(
+        [f"[{sec}]\n" + "\n".join(f"{k} = {json.dumps(v)}" for k, v in kv.items()) for sec, kv in cfg.items()]))
+    # a trajectory written by `hardbody run`
+    exe = os.environ.get("HARDBODY") or (str(hb_bin) if hb_bin.exists() else None)
+    if exe is None:
+        pytest.skip("hardbody binary not found")
+    r = subprocess.run([exe, "run", str(toml), "--out", str(tmp_path / "o"), "--quiet"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    sim = hardbody.Simulation.from_gsd(str(tmp_path / "o" / "trajectory.gsd"), cfg, frame=-1)
+    import gsd.hoomd
+    with gsd.hoomd.open(str(tmp_path / "o" / "trajectory.gsd"), mode="rb") as t:
+        exact = np.asarray(t[-1].log["particles/hardbody/position_double"])
+    assert sim.N == 108 and sim.time == 0.0
+    assert np.array_equal(sim.positions, exact)
+    e0 = sim.kinetic_energy()
+    sim.run(time=1.0)
+    assert sim.collisions > 0 and sim.overlaps() == 0
+    assert abs(sim.kinetic_energy() / e0 - 1.0) < 1e-12
+    with pytest.raises(ValueError, match="system.particles"):
+        hardbody.Simulation.from_gsd(str(tmp_path / "o" / "trajectory.gsd"),
+                                     dict(cfg, system=dict(cfg["system"], particles=100)))
+    with pytest.raises(ValueError):
+        hardbody.Simulation.from_gsd(str(tmp_path / "nothing.gsd"), cfg)
