@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "io/checkpoint.hpp"
+#include "observers/correlations.hpp"
 #include "io/config.hpp"
 #include "io/pair_query.hpp"
 #include "io/run.hpp"
@@ -203,6 +204,12 @@ class Simulation {
            " collisions=" + std::to_string(collisions()) + ">";
   }
 
+ public:
+  // synchronized state and box, for observers sampled from Python
+  hb::State state_now() const { return sim_->synchronized(); }
+  const hb::Box& box_now() const { return sim_->box(); }
+  double time_now() const { return sim_->now(); }
+
  private:
   Config cfg_;
   std::unique_ptr<SimHandle> sim_;
@@ -345,6 +352,35 @@ PYBIND11_MODULE(hardbody, m) {
       .def_property_readonly("events", &Sim::events, "Event counts by type, and stale events.")
       .def_property_readonly("config", &Sim::config, "The resolved configuration as TOML text.")
       .def("__repr__", &Sim::repr);
+
+  py::class_<hb::TimeCorrelations>(
+      m, "Correlations",
+      "MSD, C1, C2, F_self and alpha2 with multiple time origins (observers/correlations.hpp). "
+      "Call sample(sim) every `interval` of simulated time (run(time=interval) in between).")
+      .def(py::init([](double interval, int origin_every, double max_lag, double q, int q_vectors) {
+             hb::CorrelationSpec sp;
+             sp.interval = interval;
+             sp.origin_every = origin_every;
+             sp.max_lag_samples = std::max(1, int(std::lround(max_lag / interval)));
+             sp.q = q;
+             sp.max_q_vectors = q_vectors;
+             return hb::TimeCorrelations(sp);
+           }),
+           py::arg("interval") = 0.1, py::arg("origin_every") = 10, py::arg("max_lag") = 10.0,
+           py::arg("q") = 2.0 * hb::kPi, py::arg("q_vectors") = 6)
+      .def("sample", [](hb::TimeCorrelations& c, const Sim& sim) {
+             c.sample(sim.time_now(), sim.state_now(), sim.box_now());
+           }, py::arg("sim"))
+      .def_property_readonly("times", [](const hb::TimeCorrelations& c) { return py::array_t<double>(py::cast(c.times())); })
+      .def_property_readonly("msd", [](const hb::TimeCorrelations& c) { return py::array_t<double>(py::cast(c.msd())); })
+      .def_property_readonly("c1", [](const hb::TimeCorrelations& c) { return py::array_t<double>(py::cast(c.c1())); })
+      .def_property_readonly("c2", [](const hb::TimeCorrelations& c) { return py::array_t<double>(py::cast(c.c2())); })
+      .def_property_readonly("fself", [](const hb::TimeCorrelations& c) { return py::array_t<double>(py::cast(c.fself())); })
+      .def("diffusion", [](const hb::TimeCorrelations& c) {
+             const auto f = c.diffusion();
+             return py::dict(py::arg("D") = f.D, py::arg("t_from") = f.t_from, py::arg("t_to") = f.t_to,
+                             py::arg("points") = f.points);
+           });
 
   m.def("distance", &distance, py::arg("a"), py::arg("b"),
         "Distance of two posed bodies (dicts as in `hardbody distance`): "

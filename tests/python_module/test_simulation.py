@@ -263,3 +263,22 @@ def test_from_gsd_continues_from_a_trajectory_frame(tmp_path):
                                      dict(cfg, system=dict(cfg["system"], particles=100)))
     with pytest.raises(ValueError):
         hardbody.Simulation.from_gsd(str(tmp_path / "nothing.gsd"), cfg)
+
+
+def test_correlations_from_python_ballistic_start():
+    # at very low density the bodies fly freely over short lags: MSD = <v^2> t^2 exactly
+    cfg = {"system": {"particles": 256, "packing_fraction": 0.001, "seed": 2},
+           "shape": {"type": "sphere", "radius": 0.5}}
+    sim = hardbody.Simulation(cfg)
+    c = hardbody.Correlations(interval=0.05, origin_every=1, max_lag=0.5)
+    v2 = float(np.mean(np.sum(sim.velocities ** 2, axis=1)))
+    c.sample(sim)
+    for _ in range(10):
+        sim.run(time=0.05)
+        c.sample(sim)
+    t, msd = c.times, c.msd
+    assert t.shape == msd.shape and len(t) == 11
+    ok = ~np.isnan(msd)
+    assert sim.collisions == 0  # (seed 2: no collision in 0.5 time units at this density)
+    assert np.allclose(msd[ok], v2 * t[ok] ** 2, rtol=1e-9, atol=1e-12)
+    assert abs(c.c2[0] - 1.0) < 1e-12 and np.all(c.fself[ok] <= 1.0 + 1e-12)
