@@ -87,36 +87,12 @@ OverlapReport ellipsoid_overlaps(const std::vector<Vec3>& r, const std::vector<Q
 
 OverlapReport sphere_overlaps_grid(const std::vector<Vec3>& r, const Box& box, double sigma,
                                    double tol) {
-  // Cells of width >= sigma; with fewer than 3 cells along an axis, fall back to brute force.
-  int nc[3];
-  for (int k = 0; k < 3; ++k) {
-    nc[k] = static_cast<int>(std::floor(box.L[k] / sigma));
-    if (nc[k] < 3) return sphere_overlaps_brute(r, box, sigma, tol);
-  }
-  const std::size_t ncell = std::size_t(nc[0]) * nc[1] * nc[2];
-  std::vector<std::vector<std::uint32_t>> cell(ncell);
-  std::vector<std::array<int, 3>> coord(r.size());
-  for (std::uint32_t i = 0; i < r.size(); ++i) {
-    Vec3 p = r[i];
-    box.wrap(p);
-    for (int k = 0; k < 3; ++k) {
-      int c = static_cast<int>(std::floor(p[k] / box.L[k] * nc[k]));
-      coord[i][k] = c < 0 ? 0 : (c >= nc[k] ? nc[k] - 1 : c);
-    }
-    cell[(std::size_t(coord[i][2]) * nc[1] + coord[i][1]) * nc[0] + coord[i][0]].push_back(i);
-  }
+  // Pairs closer than 2 sigma: every overlap, and the closest pair of any configuration
+  // that is not extremely dilute (min_distance then agrees with the brute force).
   OverlapReport rep;
-  for (std::uint32_t i = 0; i < r.size(); ++i) {
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int x = (coord[i][0] + dx + nc[0]) % nc[0];
-          const int y = (coord[i][1] + dy + nc[1]) % nc[1];
-          const int z = (coord[i][2] + dz + nc[2]) % nc[2];
-          for (std::uint32_t j : cell[(std::size_t(z) * nc[1] + y) * nc[0] + x])
-            if (j > i) check_pair(r[i], r[j], box, sigma, tol, rep);
-        }
-  }
+  for_close_pairs(r, box, 2.0 * sigma, [&](std::uint32_t i, std::uint32_t j, const Vec3&) {
+    check_pair(r[i], r[j], box, sigma, tol, rep);
+  });
   return rep;
 }
 

@@ -87,13 +87,7 @@ struct GrowingRigidBodies {
       ContactInput<S, S> in{shape, shape, a, b, now, now, horizon, eps_d};
       in.growth = sl;
       const ContactResult r = contact_time(in, options);
-      ++stats.predictions;
-      stats.distance_evals += r.distance_evals;
-      stats.distance_nr_iterations += r.distance_nr_iterations;
-      stats.contact_nr_iterations += r.nr_iterations;
-      stats.grazing_searches += r.grazing_searches;
-      stats.fallbacks += r.fallbacks;
-      stats.distance_fallbacks += r.distance_fallbacks;
+      stats.add(r);
       if (r.status == ContactStatus::failed)
         throw SolverFailure(fmt::format(
             "contact-time solver failed for growing bodies {} and {} at t = {:.17g} (scale "
@@ -121,36 +115,13 @@ struct GrowingRigidBodies {
     if (d.status == DistanceStatus::failed)
       throw SolverFailure(fmt::format("distance solver failed at the collision of {} and {}", i, j));
     if (d.status == DistanceStatus::fallback) ++stats.collision_distance_fallbacks;
-    const Vec3 x_c = 0.5 * (d.point_a + d.point_b);
     const double grow = growth_speed(sc, sdot, d.normal, r_ab);
-    // Grazing contacts (as in RigidBodies): the gap-closing rate u.n + grow is judged here
-    // from the midpoint, by the solver from the closest points; within rounding of zero they
-    // can disagree. Every collision leaves the pair separating at least at eps_v, by raising
-    // the growth term of the impulse rule: with grow' = grow + (eps_v - closing)/2 the gap
-    // opens at -(u'.n + grow) = eps_v.
-    const double un = contact_relative_velocity(a, b, x_c, r_ab).dot(d.normal);
     const double L = shp.bounding_radius();
     const double rate = (b.v - a.v).norm() + (a.w.norm() + b.w.norm()) * L + 2.0 * sdot / sc * L;
-    const double eps_v = 1e-8 * rate;
-    const double closing = un + grow;
-    double g_eff = grow;
-    if (closing < eps_v) {
-      g_eff = grow + 0.5 * (eps_v - closing);
-      ++stats.grazing_separations;
-    }
-    CollisionRecord rec = hb::collide(a, mass, b, mass, x_c, d.normal, r_ab, g_eff);
-    s.v[i] = a.v, s.w[i] = a.w;
-    s.v[j] = b.v, s.w[j] = b.w;
-    rec.a = i;
-    rec.b = j;
-    return rec;
+    return collide_separating(s, i, j, a, b, mass, d, r_ab, grow, rate, stats);
   }
 
-  double kinetic_energy(const State& s) const {
-    double k = 0.0;
-    for (std::size_t i = 0; i < s.size(); ++i) k += hb::kinetic_energy(s.body(i), mass);
-    return k;
-  }
+  double kinetic_energy(const State& s) const { return total_kinetic_energy(s, mass); }
 };
 
 // Translational and rotational kinetic energies of spherical tops.

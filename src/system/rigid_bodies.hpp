@@ -27,6 +27,16 @@ struct SolverStats {
   std::uint64_t distance_fallbacks = 0;
   std::uint64_t collision_distance_fallbacks = 0;
   std::uint64_t grazing_separations = 0;  // collisions given the minimum separation speed
+
+  void add(const ContactResult& r) {
+    ++predictions;
+    distance_evals += r.distance_evals;
+    distance_nr_iterations += r.distance_nr_iterations;
+    contact_nr_iterations += r.nr_iterations;
+    grazing_searches += r.grazing_searches;
+    fallbacks += r.fallbacks;
+    distance_fallbacks += r.distance_fallbacks;
+  }
 };
 
 // A contact-time solve that failed (every fallback exhausted): carries a reproducer in the
@@ -35,6 +45,42 @@ class SolverFailure : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+inline double total_kinetic_energy(const State& s, const MassProperties& mass) {
+  double k = 0.0;
+  for (std::size_t i = 0; i < s.size(); ++i) k += hb::kinetic_energy(s.body(i), mass);
+  return k;
+}
+
+// The impulse of a collision of bodies i and j (states a, b at the collision time, closest
+// points and normal d, separation r_ab), written back into the State. `grow` is the sum of the
+// surfaces' outward normal speeds at the contact (0 for rigid bodies), `rate` the pair's
+// distance-rate bound.
+// Grazing contacts: the contact-time solver and this impulse judge "approaching" from slightly
+// different points (closest points vs their midpoint), so for a relative normal speed within
+// rounding of zero they can disagree and the pair would be re-predicted to collide at this same
+// instant forever. The bodies leave every collision separating at least at eps_v = 1e-8 rate
+// (through the growth term of the impulse rule: the gap opens at max(closing, eps_v)); the
+// energy change is of order eps_v^2, ~1e-16 relative.
+inline CollisionRecord collide_separating(State& s, std::uint32_t i, std::uint32_t j, BodyState a,
+                                          BodyState b, const MassProperties& mass,
+                                          const DistanceResult& d, const Vec3& r_ab, double grow,
+                                          double rate, SolverStats& stats) {
+  const Vec3 x_c = 0.5 * (d.point_a + d.point_b);
+  const double closing = contact_relative_velocity(a, b, x_c, r_ab).dot(d.normal) + grow;
+  const double eps_v = 1e-8 * rate;
+  double g_eff = grow;
+  if (closing < eps_v) {
+    g_eff = grow + 0.5 * (eps_v - closing);
+    ++stats.grazing_separations;
+  }
+  CollisionRecord rec = hb::collide(a, mass, b, mass, x_c, d.normal, r_ab, g_eff);
+  s.v[i] = a.v, s.w[i] = a.w;
+  s.v[j] = b.v, s.w[j] = b.w;
+  rec.a = i;
+  rec.b = j;
+  return rec;
+}
 
 template <Shape S>
 struct RigidBodies {
@@ -60,13 +106,7 @@ struct RigidBodies {
       b.r = shifts ? Vec3(b.r + shifts[k]) : Vec3(a.r + box.near_image(b.r - a.r));
       ContactInput<S, S> in{shape, shape, a, b, now, now, horizon, eps_d};
       const ContactResult r = contact_time(in, options);
-      ++stats.predictions;
-      stats.distance_evals += r.distance_evals;
-      stats.distance_nr_iterations += r.distance_nr_iterations;
-      stats.contact_nr_iterations += r.nr_iterations;
-      stats.grazing_searches += r.grazing_searches;
-      stats.fallbacks += r.fallbacks;
-      stats.distance_fallbacks += r.distance_fallbacks;
+      stats.add(r);
       if (r.status == ContactStatus::failed)
         throw SolverFailure(fmt::format("contact-time solver failed for bodies {} and {} at t = {:.17g}; "
                                         "reproducer: {}", i, j, now, reproducer(a, b, horizon - now)));
@@ -84,34 +124,11 @@ struct RigidBodies {
     if (d.status == DistanceStatus::failed)
       throw SolverFailure(fmt::format("distance solver failed at the collision of {} and {}", i, j));
     if (d.status == DistanceStatus::fallback) ++stats.collision_distance_fallbacks;
-    const Vec3 x_c = 0.5 * (d.point_a + d.point_b);
-    // Grazing contacts: the contact-time solver and this impulse judge "approaching" from
-    // slightly different points (closest points vs their midpoint), so for a relative normal
-    // speed within rounding of zero they can disagree and the pair would be re-predicted to
-    // collide at this same instant forever. The bodies leave every collision separating at
-    // least at eps_v = 1e-8 of the pair's rate bound (through the growth term of the impulse
-    // rule: u'.n = -max(u.n, eps_v)); the energy change is of order eps_v^2, ~1e-16 relative.
-    const double un = contact_relative_velocity(a, b, x_c, r_ab).dot(d.normal);
     const double rate = (b.v - a.v).norm() + (a.w.norm() + b.w.norm()) * shape.bounding_radius();
-    const double eps_v = 1e-8 * rate;
-    double lift = 0.0;
-    if (un < eps_v) {
-      lift = 0.5 * (eps_v - un);
-      ++stats.grazing_separations;
-    }
-    CollisionRecord rec = hb::collide(a, mass, b, mass, x_c, d.normal, r_ab, lift);
-    s.v[i] = a.v, s.w[i] = a.w;
-    s.v[j] = b.v, s.w[j] = b.w;
-    rec.a = i;
-    rec.b = j;
-    return rec;
+    return collide_separating(s, i, j, a, b, mass, d, r_ab, 0.0, rate, stats);
   }
 
-  double kinetic_energy(const State& s) const {
-    double k = 0.0;
-    for (std::size_t i = 0; i < s.size(); ++i) k += hb::kinetic_energy(s.body(i), mass);
-    return k;
-  }
+  double kinetic_energy(const State& s) const { return total_kinetic_energy(s, mass); }
 
   std::string reproducer(const BodyState& a, const BodyState& b, double t_max) const {
     auto body = [&](const BodyState& x) {
