@@ -8,13 +8,9 @@
 
 #include "system/sphere_setup.hpp"
 
-using namespace hb;
+#include "bench_common.hpp"
 
-static double cpu_now() {
-  timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
+using namespace hb;
 
 template <class Sim>
 int bench(Sim sim, const SphereSystemSpec& spec, double coll, double equil);
