@@ -11,6 +11,7 @@
 #include "collision/rigid.hpp"
 #include "contact/contact_time.hpp"
 #include "geometry/distance.hpp"
+#include "shapes/describe.hpp"
 #include "system/box.hpp"
 #include "system/state.hpp"
 
@@ -136,15 +137,10 @@ struct RigidBodies {
           "{{\"shape\": {}, \"position\": [{:.17g}, {:.17g}, {:.17g}], \"orientation\": [{:.17g}, "
           "{:.17g}, {:.17g}, {:.17g}], \"velocity\": [{:.17g}, {:.17g}, {:.17g}], "
           "\"angular_velocity\": [{:.17g}, {:.17g}, {:.17g}]}}",
-          shape_json(), x.r.x(), x.r.y(), x.r.z(), x.q.w(), x.q.x(), x.q.y(), x.q.z(), x.v.x(),
+          hb::shape_json(shape), x.r.x(), x.r.y(), x.r.z(), x.q.w(), x.q.x(), x.q.y(), x.q.z(), x.v.x(),
           x.v.y(), x.v.z(), x.w.x(), x.w.y(), x.w.z());
     };
     return fmt::format("{{\"a\": {}, \"b\": {}, \"t_max\": {:.17g}}}", body(a), body(b), t_max);
-  }
-  std::string shape_json() const {
-    const Vec3 h = shape.half_extents();
-    return fmt::format("{{\"type\": \"ellipsoid\", \"semi_axes\": [{:.17g}, {:.17g}, {:.17g}]}}",
-                       h.x(), h.y(), h.z());
   }
 };
 
