@@ -73,15 +73,17 @@ struct GrowingRigidBodies {
   ScaleLaw scale_law(double now) const { return ScaleLaw{law.scale_at(now), law.rate_at(now)}; }
 
   void contact_times(const State& s, const Box& box, std::uint32_t i, const std::uint32_t* js,
-                     const Vec3* shifts, std::size_t n, double now, double horizon,
+                     const Vec3* shifts, std::size_t n, double now, const double* horizons,
                      double* out) const {
     const BodyState a = s.body(i);  // body i is at `now`
     const ScaleLaw sl = scale_law(now);
-    if (now < law.t_stop) horizon = std::min(horizon, law.t_stop);  // the law changes there
+    const double law_end = now < law.t_stop ? law.t_stop : kInf;  // the law changes there
+    double earliest = kInf;  // earliest contact found so far: later ones are not needed
     for (std::size_t k = 0; k < n; ++k) {
       const std::uint32_t j = js[k];
       out[k] = kInf;
-      if (j == i) continue;
+      const double horizon = std::min({horizons ? horizons[k] : kInf, law_end, earliest});
+      if (j == i || !(horizon > now)) continue;
       BodyState b = s.body_at(j, now);
       b.r = shifts ? Vec3(b.r + shifts[k]) : Vec3(a.r + box.near_image(b.r - a.r));
       ContactInput<S, S> in{shape, shape, a, b, now, now, horizon, eps_d};
@@ -94,7 +96,10 @@ struct GrowingRigidBodies {
             "{:.17g}, rate {:.17g}); reproducer at scale 1: {}",
             i, j, now, sl.s, sl.rate,
             RigidBodies<S>{shape, mass, eps_d}.reproducer(a, b, horizon - now)));
-      if (r.status == ContactStatus::hit) out[k] = std::max(0.0, r.time - now);
+      if (r.status == ContactStatus::hit) {
+        out[k] = std::max(0.0, r.time - now);
+        earliest = std::min(earliest, r.time);
+      }
     }
   }
 

@@ -23,7 +23,7 @@ struct HardSpheres {
   // Batch form used by the event loop: branch-free over the candidate list, so the CPU does not
   // mispredict on which pairs approach (about half of them).
   void contact_times(const State& s, const Box& box, std::uint32_t i, const std::uint32_t* js,
-                     const Vec3* shifts, std::size_t n, double now, double /*horizon*/,
+                     const Vec3* shifts, std::size_t n, double now, const double* /*horizons*/,
                      double* out) const {
     const double* R = s.r.data()->data();
     const double* V = s.v.data()->data();

@@ -3,11 +3,17 @@
 //
 // `Model` supplies the physics of a pair:
 //   void contact_times(const State&, const Box&, i, const uint32_t* js, const Vec3* shifts,
-//                      size_t n, double now, double horizon, double* out)
+//                      size_t n, double now, const double* horizons, double* out)
 //       times from now (or +inf) of body i against bodies js; body j is placed at r_j + shift
-//       when shifts is non-null, else at its minimum image (Box::near_image). Contacts after
-//       the absolute time `horizon` (body i's next neighbour event) may be reported as +inf
-//       by models with kWindowed = true; the loop then re-predicts in full at that event.
+//       when shifts is non-null, else at its minimum image (Box::near_image). Models with
+//       kWindowed = true may report as +inf a contact with js[k] after the absolute time
+//       horizons[k], and one later than a contact already found for an earlier candidate.
+//       The loop sets horizons[k] = min(t_n, t_k): t_n body i's next neighbour event (where i
+//       is re-predicted in full), t_k the time of the event in partner k's calendar slot. At
+//       t_k the partner is re-predicted in full whatever that event turns out to be (a
+//       collision, a stale collision, a neighbour event), and then it finds the contact with i
+//       if there is one: a pair's contact later than either body's next event is never needed.
+//       Non-windowed models get horizons = nullptr and predict without limit.
 //   CollisionRecord collide(State&, const Box&, i, j, double now)     // both bodies at `now`
 //   double interaction_range() const                                  // max centre distance at contact
 // `Neighbors` (CellNeighbors, ShellNeighbors) supplies the candidates of a body and its own
@@ -177,9 +183,15 @@ class Simulation {
   // Predict body i against the candidates in cand_ and keep the earliest in `best`.
   void consider(std::uint32_t i, Event& best, double horizon = kInf) {
     const std::size_t n = cand_.size();
-    if (times_.size() < n) times_.resize(2 * n);
+    if (times_.size() < n) times_.resize(2 * n), limits_.resize(2 * n);
+    const double* limits = nullptr;
+    if constexpr (windowed()) {
+      for (std::size_t k = 0; k < n; ++k)
+        limits_[k] = std::min(horizon, queue_.event_of(cand_[k]).time);
+      limits = limits_.data();
+    }
     model_.contact_times(state_, box_, i, cand_.data(),
-                         nb_.needs_minimum_image() ? nullptr : shift_.data(), n, now_, horizon,
+                         nb_.needs_minimum_image() ? nullptr : shift_.data(), n, now_, limits,
                          times_.data());
     std::size_t kbest = n;
     double tbest = best.time - now_;
@@ -223,6 +235,7 @@ class Simulation {
   std::vector<std::uint32_t> cand_;  // candidate partners of the body being predicted
   std::vector<Vec3> shift_;          // their periodic image shifts
   std::vector<double> times_;        // their contact times
+  std::vector<double> limits_;       // their prediction horizons (windowed models)
   std::array<std::uint64_t, kEventTypes> counts_{};
   std::uint64_t stale_ = 0;
   double last_collision_time_ = -kInf;
