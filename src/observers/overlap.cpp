@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "geometry/perram_wertheim.hpp"
+#include "observers/close_pairs.hpp"
 
 namespace hb {
 
@@ -25,8 +26,6 @@ OverlapReport sphere_overlaps_brute(const std::vector<Vec3>& r, const Box& box, 
   return rep;
 }
 
-namespace {
-// Calls fn(i, j) for every pair i < j whose minimum-image centre distance is below `range`.
 void for_close_pairs(const std::vector<Vec3>& r, const Box& box, double range,
                      const std::function<void(std::uint32_t, std::uint32_t, const Vec3&)>& fn) {
   int nc[3];
@@ -69,7 +68,6 @@ void for_close_pairs(const std::vector<Vec3>& r, const Box& box, double range,
           }
         }
 }
-}  // namespace
 
 OverlapReport ellipsoid_overlaps(const std::vector<Vec3>& r, const std::vector<Quat>& q,
                                  const Box& box, const Vec3& semi_axes, double tol) {
