@@ -216,31 +216,42 @@ GrowthResult grow_bodies(const S& shape, const MassProperties& mass, State st, c
   return res;
 }
 
-// Dense ellipsoid state: the stretched FCC lattice of rigid_setup.hpp at opt.phi0 (aligned
-// bodies, Maxwell–Boltzmann velocities and spins from spec.seed), shrunk as a whole by
-// s0 = (phi0 / spec.phi)^(1/3) so that target-size bodies fill spec.phi of the box, then
-// grown to s = 1 (phi = spec.phi).  The final state is checked with the Perram–Wertheim
-// contact function; an overlap throws std::runtime_error.
-inline GrowthResult grow_to(const RigidSystemSpec& spec, const GrowthOptions& opt = {}) {
+// Dense state of bodies of shape `shape` (at its target size): the lattice start
+// `lattice(spec', box)` (rigid_setup.hpp; aligned bodies, Maxwell–Boltzmann velocities and spins
+// from spec.seed) at spec' = spec with phi = opt.phi0, shrunk as a whole by
+// s0 = (phi0 / spec.phi)^(1/3) so that target-size bodies fill spec.phi of the box, then grown to
+// s = 1 (phi = spec.phi).  The final state is checked by `check(state, box)` (the shape's
+// independent overlap test, an OverlapReport); an overlap throws std::runtime_error.
+template <Shape S, class Lattice, class Check>
+GrowthResult grow_lattice(const S& shape, const RigidSystemSpec& spec, const GrowthOptions& opt,
+                          Lattice lattice, Check check) {
   if (!(spec.phi > 0.0) || !(opt.phi0 > 0.0) || opt.phi0 > spec.phi)
     throw std::invalid_argument("grow_to: need 0 < phi0 <= phi (target)");
   RigidSystemSpec start = spec;
   start.phi = opt.phi0;
   Box box;
-  State st = ellipsoid_start(start, box);
+  State st = lattice(start, box);
   const double s0 = std::cbrt(opt.phi0 / spec.phi);
   box.L *= s0;
   for (auto& r : st.r) r *= s0;
-  const Ellipsoid shape{spec.semi_axes.x(), spec.semi_axes.y(), spec.semi_axes.z()};
   GrowthResult res = grow_bodies(shape, MassProperties::spherical_top(spec.mass, spec.inertia),
                                  std::move(st), box, s0, opt, spec.eps_d);
-  res.overlaps = ellipsoid_overlaps(res.state.r, res.state.q, res.box, spec.semi_axes);
+  res.overlaps = check(res.state, res.box);
   if (res.overlaps.overlaps != 0)
     throw std::runtime_error(fmt::format("grow_to: {} overlapping pairs in the grown state "
                                          "(min gap {:.3e}, seed {})",
                                          res.overlaps.overlaps, res.overlaps.min_distance,
                                          spec.seed));
   return res;
+}
+
+// Ellipsoids: grow_lattice from ellipsoid_start, checked with the Perram–Wertheim contact
+// function.
+inline GrowthResult grow_to(const RigidSystemSpec& spec, const GrowthOptions& opt = {}) {
+  const Ellipsoid shape{spec.semi_axes.x(), spec.semi_axes.y(), spec.semi_axes.z()};
+  return grow_lattice(shape, spec, opt, ellipsoid_start, [&](const State& s, const Box& b) {
+    return ellipsoid_overlaps(s.r, s.q, b, spec.semi_axes);
+  });
 }
 
 }  // namespace hb

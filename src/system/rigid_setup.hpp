@@ -1,8 +1,18 @@
-// Building a system of hard ellipsoids (spherical tops): an FCC lattice of aligned bodies,
-// obtained from a lattice of unit spheres by the affine map diag(a, b, c) (which maps touching
-// spheres to touching ellipsoids, so any packing fraction below the lattice's limit is
-// overlap-free), Maxwell–Boltzmann velocities and spins. The lattice is melted by the run's
-// equilibration.
+// Building a system of hard rigid bodies (spherical tops): ellipsoids and superquadrics.
+// Lattice start: an FCC lattice of aligned bodies obtained from a lattice of aligned unit bodies
+// K (semi-axes 1: the unit sphere for ellipsoids, |x|^n + |y|^m + |z|^p <= 1 for superquadrics)
+// by the affine map diag(a, b, c), which maps touching unit bodies to touching bodies, so any
+// packing fraction below the lattice's limit is overlap-free.  Aligned copies K and K + d of a
+// centrally symmetric convex body overlap iff d lies inside 2K, so the unit-body lattice with
+// constant a0 (neighbours at a0/2 (h, k, l), h + k + l even) is overlap-free iff
+// a0 >= 4 s(h, k, l) for every lattice vector, s(v) = the ray scale with s v on the surface of K
+// (K.ray_surface(v) = s v); the nearest vectors (1, 1, 0), ... bind (for the sphere a0 = 2 sqrt 2,
+// for a cube-like p -> inf superquadric a0 -> 4).  Maxwell–Boltzmann velocities and spins; the
+// lattice is melted by the run's equilibration.
+//
+// Inertia: every body is a spherical top with the scalar moment of inertia RigidSystemSpec::
+// inertia; the config default (io/config.cpp) is the paper's convention I = 2/5 m r^2 with r the
+// smallest semi-axis (ERRATA 8), for ellipsoids and superquadrics alike.
 #pragma once
 #include <array>
 #include <cmath>
@@ -11,6 +21,7 @@
 #include "neighbors/cell_neighbors.hpp"
 #include "neighbors/obb_neighbors.hpp"
 #include "shapes/ellipsoid.hpp"
+#include "shapes/superquadric.hpp"
 #include "system/init.hpp"
 #include "system/rigid_bodies.hpp"
 #include "system/simulation.hpp"
@@ -26,10 +37,43 @@ struct RigidSystemSpec {
   double kT = 1.0;
   std::uint64_t seed = 1;
   double eps_d = 1e-5;
+  Vec3 exponents = Vec3(2.0, 2.0, 2.0);  // superquadrics only
 };
 
 using EllipsoidCellSim = Simulation<RigidBodies<Ellipsoid>, CellNeighbors>;
 using EllipsoidListSim = Simulation<RigidBodies<Ellipsoid>, ObbNeighbors<Ellipsoid>>;
+using SuperquadricCellSim = Simulation<RigidBodies<Superquadric>, CellNeighbors>;
+using SuperquadricListSim = Simulation<RigidBodies<Superquadric>, ObbNeighbors<Superquadric>>;
+
+// The unit body K of the lattice start: its volume and the smallest FCC lattice constant at which
+// aligned copies do not overlap (see the header).  Default: the unit sphere.
+struct UnitBody {
+  double volume = 4.0 / 3.0 * kPi;
+  double a0_min = 2.0 * std::sqrt(2.0);
+};
+template <Shape S>
+UnitBody unit_body(const S& unit) {
+  UnitBody u;
+  u.volume = unit.volume();
+  u.a0_min = 0.0;
+  // every FCC vector (h, k, l) with h + k + l even in [-2, 2]^3 (the binding ones are nearest)
+  for (int h = -2; h <= 2; ++h)
+    for (int k = -2; k <= 2; ++k)
+      for (int l = -2; l <= 2; ++l) {
+        if ((h + k + l) % 2 != 0 || (h == 0 && k == 0 && l == 0)) continue;
+        const Vec3 v(h, k, l);
+        const double s = unit.ray_surface(v).norm() / v.norm();
+        u.a0_min = std::max(u.a0_min, 4.0 * s * (1.0 + 1e-12));
+      }
+  return u;
+}
+inline Superquadric superquadric_shape(const RigidSystemSpec& s) {
+  return Superquadric{s.semi_axes.x(), s.semi_axes.y(), s.semi_axes.z(),
+                      s.exponents.x(), s.exponents.y(), s.exponents.z()};
+}
+inline UnitBody superquadric_unit_body(const RigidSystemSpec& s) {
+  return unit_body(Superquadric{1.0, 1.0, 1.0, s.exponents.x(), s.exponents.y(), s.exponents.z()});
+}
 
 // FCC cell counts (mx, my, mz) with 4 mx my mz >= n that make the stretched box closest to a
 // cube, and the largest packing fraction that lattice allows.
@@ -37,7 +81,7 @@ struct StretchedLattice {
   std::array<int, 3> m{1, 1, 1};
   double phi_max = 0.0;
 };
-inline StretchedLattice stretched_lattice(std::size_t n, const Vec3& s) {
+inline StretchedLattice stretched_lattice(std::size_t n, const Vec3& s, const UnitBody& unit = {}) {
   StretchedLattice best;
   double best_aniso = kInf;
   const int top = static_cast<int>(std::ceil(std::cbrt(double(n) / 4.0) * 4.0)) + 2;
@@ -52,21 +96,26 @@ inline StretchedLattice stretched_lattice(std::size_t n, const Vec3& s) {
         if (aniso < best_aniso) {
           best_aniso = aniso;
           best.m = {mx, my, mz};
-          // unit spheres touching at lattice constant a0 = 2 sqrt(2)
-          best.phi_max = double(n) * (4.0 / 3.0 * kPi) / (std::pow(2.0 * std::sqrt(2.0), 3) * mx * my * mz);
+          // unit bodies touching at lattice constant a0_min (2 sqrt(2) for spheres)
+          best.phi_max = double(n) * unit.volume / (std::pow(unit.a0_min, 3) * mx * my * mz);
         }
       }
   if (best_aniso == kInf) throw std::invalid_argument("no lattice for this number of bodies");
   return best;
 }
 
-inline State ellipsoid_start(const RigidSystemSpec& s, Box& box) {
-  const StretchedLattice lat = stretched_lattice(s.n, s.semi_axes);
+// Lattice constant of the unit-body lattice with cell counts m that gives packing fraction phi.
+inline double lattice_constant(std::size_t n, double phi, const std::array<int, 3>& m,
+                               const UnitBody& unit) {
+  return std::cbrt(double(n) * unit.volume / (phi * m[0] * m[1] * m[2]));
+}
+
+inline State lattice_start(const RigidSystemSpec& s, const UnitBody& unit, Box& box) {
+  const StretchedLattice lat = stretched_lattice(s.n, s.semi_axes, unit);
   if (s.phi > lat.phi_max * (1.0 - 1e-12))
     throw std::invalid_argument("packing fraction too high for the lattice start");
   const auto& m = lat.m;
-  // lattice constant of the unit-sphere lattice giving the packing fraction
-  const double a0 = std::cbrt(double(s.n) * (4.0 / 3.0 * kPi) / (s.phi * m[0] * m[1] * m[2]));
+  const double a0 = lattice_constant(s.n, s.phi, m, unit);
   box.L = Vec3(s.semi_axes.x() * a0 * m[0], s.semi_axes.y() * a0 * m[1], s.semi_axes.z() * a0 * m[2]);
   static const double basis[4][3] = {{0, 0, 0}, {0.5, 0.5, 0}, {0.5, 0, 0.5}, {0, 0.5, 0.5}};
   State st;
@@ -84,10 +133,20 @@ inline State ellipsoid_start(const RigidSystemSpec& s, Box& box) {
   return st;
 }
 
+inline State ellipsoid_start(const RigidSystemSpec& s, Box& box) { return lattice_start(s, UnitBody{}, box); }
+inline State superquadric_start(const RigidSystemSpec& s, Box& box) {
+  return lattice_start(s, superquadric_unit_body(s), box);
+}
+
 inline RigidBodies<Ellipsoid> ellipsoid_model(const RigidSystemSpec& s) {
   RigidBodies<Ellipsoid> m{Ellipsoid{s.semi_axes.x(), s.semi_axes.y(), s.semi_axes.z()},
                            MassProperties::spherical_top(s.mass, s.inertia), s.eps_d};
   return m;
+}
+
+inline RigidBodies<Superquadric> superquadric_model(const RigidSystemSpec& s) {
+  return RigidBodies<Superquadric>{superquadric_shape(s),
+                                   MassProperties::spherical_top(s.mass, s.inertia), s.eps_d};
 }
 
 inline EllipsoidCellSim make_ellipsoid_cell_simulation(const RigidSystemSpec& s) {
