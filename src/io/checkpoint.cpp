@@ -81,6 +81,9 @@ void fill_frame(gsd::HoomdFrame& f, const State& s, const Box& box, double now, 
   f.types = {shape.type};
   if (shape.type == "sphere")
     f.type_shapes = {gsd::sphere_shape(2.0 * shape.radius)};
+  else if (shape.type == "superquadric")
+    f.type_shapes = {gsd::superquadric_shape({shape.semi_axes.x(), shape.semi_axes.y(), shape.semi_axes.z()},
+                                             {shape.exponents.x(), shape.exponents.y(), shape.exponents.z()})};
   else
     f.type_shapes = {gsd::ellipsoid_shape(shape.semi_axes.x(), shape.semi_axes.y(), shape.semi_axes.z())};
   // Exact state in the engine's frame [0, L) (box_origin 0), for analysis and conversion.

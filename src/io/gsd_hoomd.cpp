@@ -12,6 +12,9 @@
 #include <optional>
 #include <stdexcept>
 
+#include "observers/overlap_sampling.hpp"  // fibonacci_sphere
+#include "shapes/superquadric.hpp"
+
 namespace hb::gsd {
 
 namespace {
@@ -105,6 +108,21 @@ std::string convex_polyhedron_shape(const std::vector<std::array<double, 3>>& ve
                         {"rounding_radius", rounding_radius},
                         {"vertices", vertices}}
       .dump();
+}
+
+std::string superquadric_shape(const std::array<double, 3>& semi_axes,
+                               const std::array<double, 3>& exponents, int vertices) {
+  const Superquadric s{semi_axes[0], semi_axes[1], semi_axes[2],
+                       exponents[0], exponents[1], exponents[2]};
+  const int half = std::max(vertices / 2, 4);
+  std::vector<std::array<double, 3>> v;
+  v.reserve(2 * std::size_t(half));
+  auto put = [&](const Vec3& x) { v.push_back({x.x(), x.y(), x.z()}); };
+  for (const Vec3& n : sampling_detail::fibonacci_sphere(half)) {
+    put(s.ray_surface(s.axes().cwiseProduct(n)));
+    put(s.support_point(n));
+  }
+  return convex_polyhedron_shape(v);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -56,6 +56,12 @@ std::string sphere_shape(double diameter);
 std::string ellipsoid_shape(double a, double b, double c);
 std::string convex_polyhedron_shape(const std::vector<std::array<double, 3>>& vertices,
                                     double rounding_radius = 0.0);
+// The schema has no superquadric: a ConvexPolyhedron whose `vertices` are surface points of the
+// body |x/a|^n + |y/b|^m + |z/c|^p <= 1 (half along rays through a stretched Fibonacci sphere,
+// half the support points of Fibonacci normals, which crowd where the surface bends: edges and
+// corners), so OVITO and HOOMD's viewers draw the body's convex hull.
+std::string superquadric_shape(const std::array<double, 3>& semi_axes,
+                               const std::array<double, 3>& exponents, int vertices = 400);
 
 // A chunk as it goes to the file.
 struct EncodedChunk {

@@ -21,6 +21,7 @@
 #include "io/progress.hpp"
 #include "observers/correlations.hpp"
 #include "observers/overlap.hpp"
+#include "observers/overlap_sampling.hpp"
 #include "observers/structure.hpp"
 #include "observers/thermo.hpp"
 #include "system/init.hpp"
@@ -507,17 +508,22 @@ SphereSystemSpec plan_spheres(const Config& c) {
   return p;
 }
 
-RigidSystemSpec plan_ellipsoids(const Config& c) {
+namespace {
+
+// The rigid-body plan for a lattice of unit bodies `unit` and bodies of bounding radius
+// `bounding` (plan_ellipsoids, plan_superquadrics).
+RigidSystemSpec plan_rigid(const Config& c, const UnitBody& unit, double bounding) {
   RigidSystemSpec p;
   p.n = c.particles;
   p.phi = c.packing_fraction;
   p.semi_axes = c.shape.semi_axes;
+  p.exponents = c.shape.exponents;
   p.mass = c.mass;
   p.inertia = c.shape.inertia;
   p.kT = c.temperature;
   p.seed = c.seed;
   p.eps_d = c.eps_d;
-  const StretchedLattice lat = stretched_lattice(c.particles, c.shape.semi_axes);
+  const StretchedLattice lat = stretched_lattice(c.particles, c.shape.semi_axes, unit);
   const bool grow = c.init_method == "grow" && c.packing_fraction > c.init_phi0;
   if (grow && c.init_phi0 > lat.phi_max * (1.0 - 1e-12))
     throw ConfigError(fmt::format("{}: key 'init.phi0': {} is too dense for the lattice start",
@@ -526,17 +532,79 @@ RigidSystemSpec plan_ellipsoids(const Config& c) {
     throw ConfigError(fmt::format(
         "{}: key 'system.packing_fraction': {} is too dense for the lattice start with {} "
         "particles (at most {:.4f})", c.source, c.packing_fraction, c.particles, lat.phi_max));
-  const double a0 = std::cbrt(double(c.particles) * (4.0 / 3.0 * kPi) /
-                              (c.packing_fraction * lat.m[0] * lat.m[1] * lat.m[2]));
+  const double a0 = lattice_constant(c.particles, c.packing_fraction, lat.m, unit);
   const Vec3 L(c.shape.semi_axes.x() * a0 * lat.m[0], c.shape.semi_axes.y() * a0 * lat.m[1],
                c.shape.semi_axes.z() * a0 * lat.m[2]);
-  const double range = 2.0 * c.shape.semi_axes.maxCoeff();
+  const double range = 2.0 * bounding;
   if (L.minCoeff() < 2.0 * range)
     throw ConfigError(fmt::format(
         "{}: key 'system.particles': {} particles at packing fraction {} give a box side of "
         "{:.3g}, less than two body lengths ({:.3g}); use more particles",
         c.source, c.particles, c.packing_fraction, L.minCoeff(), 2.0 * range));
   return p;
+}
+
+RigidSystemSpec plan_superquadrics(const Config& c) {
+  RigidSystemSpec p;
+  p.exponents = c.shape.exponents;
+  p.semi_axes = c.shape.semi_axes;
+  return plan_rigid(c, superquadric_unit_body(p), superquadric_shape(p).bounding_radius());
+}
+
+// A run of rigid bodies of shape S: `model` builds the pair model, `lattice(spec, box)` the
+// lattice start, `grow(options)` the grown start, `overlaps` is the independent check.
+template <Shape S, class Model, class Lattice, class Grow>
+void run_rigid(const Config& cfg, const RunOptions& opt, const std::string& dir,
+               const RigidSystemSpec& spec, Model model, Lattice lattice, Grow grow,
+               std::function<OverlapReport(const State&, const Box&)> overlaps) {
+  const RigidBodies<S> proto = model(spec);
+  const SystemOps ops{[proto](const State& s) { return proto.kinetic_energy(s); },
+                      std::move(overlaps)};
+  // The initial state: the stretched lattice at the target density, or (init.method =
+  // "grow", above init.phi0) a dilute lattice grown Lubachevsky–Stillinger style.
+  const bool grown = cfg.init_method == "grow" && cfg.packing_fraction > cfg.init_phi0;
+  auto start = [&](Box& box) {
+    if (!grown) return lattice(spec, box);
+    GrowthOptions go;
+    go.rate = cfg.init_growth_rate;
+    go.phi0 = cfg.init_phi0;
+    go.kT = cfg.temperature;
+    if (!opt.quiet)
+      std::fprintf(stderr, "hardbody: growing from phi = %g to %g (rate %g) ...\n", go.phi0,
+                   cfg.packing_fraction, go.rate);
+    GrowthResult g = grow(go);
+    (*ops.extra)["init"] = {{"method", "grow"}, {"phi0", go.phi0}, {"growth_rate", go.rate},
+                            {"growth_time", g.time}, {"growth_collisions", g.collisions},
+                            {"growth_wall_seconds", g.wall_seconds},
+                            {"growth_velocity_rescales", g.rescales},
+                            {"min_distance_after_growth", g.overlaps.min_distance}};
+    box = g.box;
+    return std::move(g.state);
+  };
+  if (!grown) (*ops.extra)["init"] = {{"method", "lattice"}};
+  auto make = [&](auto nb) {
+    return [&, nb] {
+      Box box;
+      State st = start(box);
+      return Simulation<RigidBodies<S>, decltype(nb)>(box, std::move(st), model(spec), nb);
+    };
+  };
+  auto remake_model = [&] { return model(spec); };
+  if (cfg.neighbors_method == "nnl") {
+    using Sim = Simulation<RigidBodies<S>, ObbNeighbors<S>>;
+    const ObbNeighbors<S> nb(proto.shape, cfg.shell);
+    start_or_resume<Sim>(cfg, opt, dir, make(nb), remake_model, nb, ops);
+  } else {
+    using Sim = Simulation<RigidBodies<S>, CellNeighbors>;
+    const CellNeighbors nb(proto.interaction_range());
+    start_or_resume<Sim>(cfg, opt, dir, make(nb), remake_model, nb, ops);
+  }
+}
+
+}  // namespace
+
+RigidSystemSpec plan_ellipsoids(const Config& c) {
+  return plan_rigid(c, UnitBody{}, c.shape.semi_axes.maxCoeff());
 }
 
 void run_simulation(const RunOptions& opt) {
@@ -559,53 +627,27 @@ void run_simulation(const RunOptions& opt) {
                                        model, CellNeighbors(spec.sigma), ops);
     } else if (cfg.shape.type == "ellipsoid") {
       const RigidSystemSpec spec = plan_ellipsoids(cfg);
-      const auto proto = ellipsoid_model(spec);
-      const SystemOps ops{[proto](const State& s) { return proto.kinetic_energy(s); },
-                          [axes = spec.semi_axes](const State& s, const Box& b) {
-                            return ellipsoid_overlaps(s.r, s.q, b, axes);
-                          }};
-      // The initial state: the stretched lattice at the target density, or (init.method =
-      // "grow", above init.phi0) a dilute lattice grown Lubachevsky–Stillinger style.
-      const bool grow = cfg.init_method == "grow" && cfg.packing_fraction > cfg.init_phi0;
-      auto start = [&](Box& box) {
-        if (!grow) return ellipsoid_start(spec, box);
-        GrowthOptions go;
-        go.rate = cfg.init_growth_rate;
-        go.phi0 = cfg.init_phi0;
-        go.kT = cfg.temperature;
-        if (!opt.quiet)
-          std::fprintf(stderr, "hardbody: growing from phi = %g to %g (rate %g) ...\n", go.phi0,
-                       cfg.packing_fraction, go.rate);
-        GrowthResult g = grow_to(spec, go);
-        (*ops.extra)["init"] = {{"method", "grow"}, {"phi0", go.phi0}, {"growth_rate", go.rate},
-                                {"growth_time", g.time}, {"growth_collisions", g.collisions},
-                                {"growth_wall_seconds", g.wall_seconds},
-                                {"growth_velocity_rescales", g.rescales},
-                                {"min_distance_after_growth", g.overlaps.min_distance}};
-        box = g.box;
-        return std::move(g.state);
+      run_rigid<Ellipsoid>(
+          cfg, opt, dir, spec, ellipsoid_model, ellipsoid_start,
+          [&](const GrowthOptions& go) { return grow_to(spec, go); },
+          [axes = spec.semi_axes](const State& s, const Box& b) {
+            return ellipsoid_overlaps(s.r, s.q, b, axes);
+          });
+    } else if (cfg.shape.type == "superquadric") {
+      // Spherical tops with the ellipsoids' inertia convention (config: 2/5 m r_min^2 unless
+      // shape.inertia is given); the independent check samples the surfaces
+      // (observers/overlap_sampling.hpp), one sampling shared by every check of the run.
+      const RigidSystemSpec spec = plan_superquadrics(cfg);
+      const auto check = std::make_shared<const SurfaceSampling<Superquadric>>(superquadric_shape(spec));
+      auto overlaps = [check](const State& s, const Box& b) {
+        return sampled_overlaps(s.r, s.q, b, *check);
       };
-      if (!grow) (*ops.extra)["init"] = {{"method", "lattice"}};
-      if (cfg.neighbors_method == "nnl")
-        start_or_resume<EllipsoidListSim>(
-            cfg, opt, dir,
-            [&] {
-              Box box;
-              State st = start(box);
-              return EllipsoidListSim(box, std::move(st), ellipsoid_model(spec),
-                                      ObbNeighbors<Ellipsoid>(proto.shape, cfg.shell));
-            },
-            [&] { return ellipsoid_model(spec); }, ObbNeighbors<Ellipsoid>(proto.shape, cfg.shell), ops);
-      else
-        start_or_resume<EllipsoidCellSim>(
-            cfg, opt, dir,
-            [&] {
-              Box box;
-              State st = start(box);
-              return EllipsoidCellSim(box, std::move(st), ellipsoid_model(spec),
-                                      CellNeighbors(proto.interaction_range()));
-            },
-            [&] { return ellipsoid_model(spec); }, CellNeighbors(proto.interaction_range()), ops);
+      run_rigid<Superquadric>(
+          cfg, opt, dir, spec, superquadric_model, superquadric_start,
+          [&](const GrowthOptions& go) {
+            return grow_lattice(superquadric_shape(spec), spec, go, superquadric_start, overlaps);
+          },
+          overlaps);
     } else {
       throw ConfigError(fmt::format("{}: key 'shape.type': '{}' bodies are not yet supported by "
                                     "`hardbody run`", cfg.source, cfg.shape.type));
