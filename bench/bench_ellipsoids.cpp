@@ -34,13 +34,14 @@ int bench(Sim sim, const RigidSystemSpec& spec, double x0, const char* method, d
       "\"collisions_per_second\":%.1f,\"predictions_per_collision\":%.2f,"
       "\"distance_evals_per_prediction\":%.2f,\"distance_nr_iterations_per_eval\":%.2f,"
       "\"neighbour_events_per_collision\":%.3f,\"hits_per_collision\":%.2f,"
-      "\"distance_evals_per_hit\":%.2f,\"fallbacks\":%llu}\n",
+      "\"distance_evals_per_hit\":%.2f,\"axis_steps_per_collision\":%.1f,\"fallbacks\":%llu}\n",
       spec.n, spec.phi, x0, method, shell, spec.eps_d, nc, dt, 1e6 * dt / nc, nc / dt, preds / nc,
       double(s1.distance_evals - s0.distance_evals) / std::max(preds, 1.0),
       double(s1.distance_nr_iterations - s0.distance_nr_iterations) /
           std::max(double(s1.distance_evals - s0.distance_evals), 1.0),
       double(e1[2] + e1[3] - e0[2] - e0[3]) / nc, double(s1.hits - s0.hits) / nc,
       double(s1.hit_distance_evals - s0.hit_distance_evals) / std::max(double(s1.hits - s0.hits), 1.0),
+      double(s1.axis_steps - s0.axis_steps) / nc,
       (unsigned long long)(s1.fallbacks + s1.distance_fallbacks - s0.fallbacks - s0.distance_fallbacks));
   return 0;
 }

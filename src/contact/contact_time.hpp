@@ -38,18 +38,19 @@
 //     d(t) (Illinois + bisection) and its left end, where d > 0, is returned: a time never later
 //     than the contact.
 //  Separating-axis advancement (beyond the paper; shapes with a support function, no growth).
-//  For any unit vector n the gap along n,
-//     g_n(t) = n.(r_B(t) - r_A(t)) - h_A(R_A(t)^T n) - h_B(-R_B(t)^T n),
-//  h the support function, is a lower bound of the distance: g_n > 0 means a plane normal to n
-//  separates the bodies.  With n the normal of a distance sample, g_n = d there, and it stays a
-//  close lower bound for a while.  Its rate: d/dt R^T n = -R^T (w x n(t)), n(t) n rotated about
-//  w, and grad h is the support point (|R p| <= L), so
-//     |g_n'| <= K_n = |n.(v_B - v_A)| + L_A |w_A x n| + L_B |w_B x n|  <=  K,
-//  a constant (rotation about w keeps |w x n|).  From a sample with d >= eps_d the solver steps
-//  dt = g_n / K_n on g_n (two support functions per step instead of a distance solve) while
-//  g_n >= eps_d, then takes a distance sample there (no contact before it: d >= g_n > 0 on every
-//  step) and continues; a pair that cannot meet inside the window costs one distance solve.
-//  Near contact (d < eps_d) the rate-bound stepping of step 2 takes over unchanged.
+//  The gap g_n(t) along a fixed unit vector n (contact/axis_gap.hpp) is a lower bound of the
+//  distance that costs two support functions instead of a distance solve, with the rate bound
+//  |g_n'| <= K_n <= K and, for shapes with bounded curvature, |g_n''| <= M.  It is advanced by
+//  conservative steps, the larger of g / K_n and the positive root of g + g' dt - M dt^2 / 2:
+//   a. before the first distance solve, along an axis found by a few gradient-ascent steps of
+//      the gap over directions (`separating_axis`), re-aimed where the gap runs low; a pair
+//      that cannot meet inside the window usually costs no distance solve at all, and the
+//      first solve starts from the support points of the last axis (a warm start);
+//   b. after every distance sample with d >= eps_d, or with d' > 0 for curved shapes (a pair
+//      that just collided and separates), along its normal (there g_n = d, g_n' = d').
+//  Each step leaves g > 0, hence d > 0, behind it, so no contact is skipped; near contact
+//  (d < eps_d and approaching) the rate-bound stepping of step 2 takes over unchanged.
+//  `ContactOptions::separating_axis = false` gives the paper's algorithm alone (tests compare).
 //  Initial overlap (d < 0 at the first evaluated time): if the bodies approach (d' < 0) this is a
 //  contact at that time (`hit`, initial_overlap = true); if they separate (just after a
 //  collision, rounding) the search continues and only a later sign change counts.
@@ -78,6 +79,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "contact/axis_gap.hpp"
 #include "geometry/distance.hpp"
 #include "geometry/posed.hpp"
 #include "math/brent.hpp"
@@ -391,36 +393,49 @@ struct Solver {
   }
 
   static constexpr bool kAxis = SupportShape<SA> && SupportShape<SB>;
+  static constexpr bool kCurved = [] {
+    if constexpr (kAxis) return AxisGap<SA, SB>::kCurved;
+    else return false;
+  }();
 
   // Separating-axis advancement from sample s (d >= eps_d, see the header): the time up to
   // which no contact is possible, >= hi if none in the window.
-  double advance_on_axis(const Sample& s, double hi) {
-    const Vec3 n = s.res.normal;
-    const Vec3 dv = in.b.v - in.a.v, dr = in.b.r - in.a.r;
-    const double La = in.shape_a.bounding_radius(), Lb = in.shape_b.bounding_radius();
-    const double Kn = std::abs(n.dot(dv)) + La * in.a.w.cross(n).norm() + Lb * in.b.w.cross(n).norm();
-    const Mat3 RaT = in.a.q.toRotationMatrix().transpose(), RbT = in.b.q.toRotationMatrix().transpose();
-    const double wa = in.a.w.norm(), wb = in.b.w.norm();
-    const Vec3 ka = wa > 0.0 ? Vec3(in.a.w / wa) : Vec3::Zero();
-    const Vec3 kb = wb > 0.0 ? Vec3(in.b.w / wb) : Vec3::Zero();
-    // n rotated by -|w| tau about w (Rodrigues): R(t)^T n = R(t_state)^T rot(-|w| tau) n
-    auto back = [&](const Vec3& k, double w, double tau) -> Vec3 {
-      if (w == 0.0) return n;
-      const double th = -w * tau, c = std::cos(th), sn = std::sin(th);
-      return n * c + k.cross(n) * sn + k * (k.dot(n) * (1.0 - c));
-    };
-    auto gap = [&](double t) {
-      const double tau = t - in.t_state;
-      ++out.axis_steps;
-      return n.dot(dr + dv * tau) - in.shape_a.support(RaT * back(ka, wa, tau)) -
-             in.shape_b.support(-(RbT * back(kb, wb, tau)));
-    };
-    double t = s.t, g = gap(t);
-    for (int k = 0; k < 64 && g >= in.eps_d; ++k) {
-      const double t1 = t + g / Kn;  // Kn = 0: the gap never changes, no contact
+  double advance_on_axis(const Sample& s, double hi) { return advance_on_axis(s.res.normal, s.t, hi); }
+
+  Vec3 axis_ma = Vec3::Zero(), axis_mb = Vec3::Zero();  // body-frame axes of the last gap
+
+  // The same along the unit vector n from time t0 (gap, rate and curvature bounds:
+  // contact/axis_gap.hpp).
+  double advance_on_axis(const Vec3& n, double t0, double hi) {
+    using Gap = AxisGap<SA, SB>;
+    const Gap G(in.shape_a, in.a, in.shape_b, in.b, in.t_state, n);
+    // Second-order steps converge on the gap's zero: follow it closer than eps_d. They also
+    // leave a touching pair that separates (g ~ 0, g' > 0: just after its collision): the
+    // parabola g + g' dt - M dt^2 / 2 stays positive up to (g' + q) / M. A gap negative at
+    // rounding level (-1e-12 L, the solver's noise guard) counts as touching.
+    const double floor = Gap::kCurved ? 1e-3 * in.eps_d : in.eps_d;
+    const double noise = -1e-12 * L;
+    double t = t0, slope = 0.0;
+    double g = G.value(t, slope, axis_ma, axis_mb);
+    ++out.axis_steps;
+    for (int k = 0; k < 64; ++k) {
+      const bool leaving = Gap::kCurved && slope > 0.0 && g >= noise;
+      if (!(g >= floor || leaving)) break;
+      // no zero of g before t + dt: first order g - Kn dt > 0, or second order
+      // g + g' dt - M dt^2 / 2 > 0 (the positive root, written without cancellation)
+      double dt = std::max(g, 0.0) / G.Kn;  // Kn = 0: the gap never changes, no contact
+      if constexpr (Gap::kCurved) {
+        const double q = std::sqrt(std::max(slope * slope + 2.0 * G.M * g, 0.0));
+        const double dt2 =
+            slope <= 0.0 ? 2.0 * g / (q - slope) : (G.M > 0.0 ? (slope + q) / G.M : kInf);
+        dt = std::max(dt, dt2);
+      }
+      if (!(dt > 0.0)) break;
+      const double t1 = t + dt;
       if (!(t1 < hi)) return hi;
       t = t1;
-      g = gap(t);
+      g = G.value(t, slope, axis_ma, axis_mb);
+      ++out.axis_steps;
     }
     return t;
   }
@@ -515,6 +530,25 @@ struct Solver {
       out.status = ContactStatus::none;
       return;
     }
+    if constexpr (kAxis) {
+      // Before any distance solve: advance along the line of centres (a pair that cannot
+      // meet inside the window usually costs no distance solve at all).
+      // Re-aim the axis where the gap ran low, as long as that makes progress.
+      for (int k = 0; k < 8 && o.separating_axis && !grow; ++k) {
+        double g0;
+        const Vec3 n = separating_axis(in.shape_a, in.a, in.shape_b, in.b, lo - in.t_state, 3, g0);
+        if (!(n.squaredNorm() > 0.0)) break;
+        const double t = advance_on_axis(n, lo, hi);
+        if (!(t < hi)) return;  // none
+        if (!(t > lo)) break;
+        lo = t;
+      }
+      // The support points along the last axis are close to the closest points: the first
+      // distance solve starts from them instead of the cold guess.
+      if (o.separating_axis && !grow && !warm.valid && axis_ma.squaredNorm() > 0.0)
+        warm = DistanceWarmStart{in.shape_a.support_point(axis_ma), in.shape_b.support_point(axis_mb),
+                                 1.0, 0.0, true};
+    }
     Sample s = eval(lo);
     if (failed) return;
     if (s.d <= 0.0 && (s.dd < 0.0 || K == 0.0)) {  // overlapping and approaching
@@ -525,7 +559,7 @@ struct Solver {
     if (K == 0.0) return;  // no relative motion: the distance never changes
     while (s.t < hi) {
       if constexpr (kAxis) {
-        if (o.separating_axis && !grow && s.d >= in.eps_d) {
+        if (o.separating_axis && !grow && (s.d >= in.eps_d || (kCurved && s.dd > 0.0))) {
           const double t = advance_on_axis(s, hi);
           if (!(t < hi)) break;
           if (t > s.t) {

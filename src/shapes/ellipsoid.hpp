@@ -39,6 +39,12 @@ struct Ellipsoid {
 
   double support(const Vec3& n) const { return std::sqrt(n.cwiseProduct(n).dot(sq())); }
   Vec3 support_point(const Vec3& n) const { return n.cwiseProduct(sq()) / support(n); }
+  // Largest principal radius of curvature of the surface, max(a,b,c)^2 / min(a,b,c): it bounds
+  // the support Hessian, |m^T (d^2 h) m| <= rho_max |m|^2 for unit n (used by the contact solver).
+  double max_curvature_radius() const {
+    const double mx = std::max({a, b, c}), mn = std::min({a, b, c});
+    return mx * mx / mn;
+  }
   Mat3 support_hessian(const Vec3& n) const {
     const double h = support(n);
     const Vec3 mn = n.cwiseProduct(sq());
@@ -62,6 +68,7 @@ struct Sphere {
   Vec3 ray_surface(const Vec3& u) const { return u * (radius / u.norm()); }
 
   double support(const Vec3& n) const { return radius * n.norm(); }
+  double max_curvature_radius() const { return radius; }
   Vec3 support_point(const Vec3& n) const { return n * (radius / n.norm()); }
   Mat3 support_hessian(const Vec3& n) const {
     const double nn = n.norm();

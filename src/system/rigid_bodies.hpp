@@ -21,6 +21,7 @@ namespace hb {
 struct SolverStats {
   std::uint64_t predictions = 0;       // contact-time solves
   std::uint64_t distance_evals = 0;    // distance solves inside them
+  std::uint64_t axis_steps = 0;        // separating-axis gap evaluations inside them
   std::uint64_t distance_nr_iterations = 0;
   std::uint64_t contact_nr_iterations = 0;
   std::uint64_t grazing_searches = 0;
@@ -34,6 +35,7 @@ struct SolverStats {
   void add(const ContactResult& r) {
     ++predictions;
     distance_evals += r.distance_evals;
+    axis_steps += r.axis_steps;
     distance_nr_iterations += r.distance_nr_iterations;
     contact_nr_iterations += r.nr_iterations;
     grazing_searches += r.grazing_searches;
