@@ -107,10 +107,11 @@ class AxisGap {
 // beta = |c| + (L_A + L_B) / 2 (about the curvature of G on the sphere; the plain fixed point
 // n <- x_B - x_A oscillates), from the line of centres; a step that does not increase the gap
 // is retried at half the length. Returns the best axis, its gap in `gap` (one evaluation per
-// iteration). Zero vector if the centres coincide.
+// iteration; the search stops early once the gap reaches `enough`). Zero vector if the centres
+// coincide.
 template <SupportShape SA, SupportShape SB>
 Vec3 separating_axis(const SA& sa, const BodyState& a, const SB& sb, const BodyState& b,
-                     double tau, int iterations, double& gap) {
+                     double tau, int iterations, double& gap, double enough = kInf) {
   const Vec3 c = (b.r - a.r) + (b.v - a.v) * tau;
   gap = -kInf;
   if (!(c.squaredNorm() > 0.0)) return Vec3::Zero();
@@ -124,7 +125,7 @@ Vec3 separating_axis(const SA& sa, const BodyState& a, const SB& sb, const BodyS
   };
   Vec3 best = c.normalized(), sep;
   gap = eval(best, sep);
-  for (int it = 1; it < iterations; ++it) {
+  for (int it = 1; it < iterations && gap < enough; ++it) {
     const Vec3 n = (best + (sep - gap * best) / beta).normalized();
     Vec3 s;
     const double g = eval(n, s);

@@ -535,9 +535,12 @@ struct Solver {
       // meet inside the window usually costs no distance solve at all).
       // Re-aim the axis where the gap ran low, as long as that makes progress.
       for (int k = 0; k < 8 && o.separating_axis && !grow; ++k) {
+        // a gap of K (hi - lo) already rules out any contact in the window
         double g0;
-        const Vec3 n = separating_axis(in.shape_a, in.a, in.shape_b, in.b, lo - in.t_state, 3, g0);
+        const Vec3 n = separating_axis(in.shape_a, in.a, in.shape_b, in.b, lo - in.t_state, 3, g0,
+                                       K * (hi - lo));
         if (!(n.squaredNorm() > 0.0)) break;
+        if (g0 >= K * (hi - lo)) return;  // none
         const double t = advance_on_axis(n, lo, hi);
         if (!(t < hi)) return;  // none
         if (!(t > lo)) break;
