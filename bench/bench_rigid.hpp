@@ -1,0 +1,326 @@
+// Shared pieces of the rigid-body performance benchmarks (bench_rigid, bench_ratio): key=value
+// arguments, building ellipsoid / superquadric / hard-sphere simulations from one description,
+// and timing a stretch of collisions with the solver counters it took.
+#pragma once
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "system/rigid_setup.hpp"
+#include "system/sphere_setup.hpp"
+
+#include "bench_common.hpp"
+
+namespace hbbench {
+
+using hb::Vec3;
+using Json = nlohmann::ordered_json;
+
+// Arguments `key=value`; every key must be known (a typo must not silently fall back to a default).
+class Args {
+ public:
+  Args(int argc, char** argv) {
+    for (int k = 1; k < argc; ++k) {
+      const std::string a = argv[k];
+      const auto eq = a.find('=');
+      if (eq == std::string::npos || eq == 0) throw std::invalid_argument("expected key=value, got '" + a + "'");
+      kv_[a.substr(0, eq)] = a.substr(eq + 1);
+    }
+  }
+  double num(const std::string& key, double def) {
+    used_[key] = true;
+    const auto it = kv_.find(key);
+    if (it == kv_.end()) return def;
+    char* end = nullptr;
+    const double v = std::strtod(it->second.c_str(), &end);
+    if (end == it->second.c_str() || *end != '\0') throw std::invalid_argument("bad number for " + key);
+    return v;
+  }
+  std::string str(const std::string& key, const std::string& def) {
+    used_[key] = true;
+    const auto it = kv_.find(key);
+    return it == kv_.end() ? def : it->second;
+  }
+  // Call after reading every key.
+  void check_all_used() const {
+    for (const auto& [k, v] : kv_)
+      if (!used_.count(k)) throw std::invalid_argument("unknown argument '" + k + "'");
+  }
+
+ private:
+  std::map<std::string, std::string> kv_;
+  std::map<std::string, bool> used_;
+};
+
+// One rigid-body state point.  Bodies of revolution about body x: semi-axes (X0 b, b, b); the
+// superquadric exponents are (2, 2, p) (the paper's section 5: n = m = 2, p varied).
+struct RigidPoint {
+  std::string shape = "ellipsoid";  // "ellipsoid" | "superquadric"
+  std::string method = "nnl";       // "nnl" | "cells"
+  hb::RigidSystemSpec spec;
+  double x0 = 2.0;
+  double p = 2.0;
+  double shell = 0.15;
+};
+
+// Reads shape, N, phi, X0, b, p, inertia, eps_d, seed, method, shell.  Defaults: the
+// ellipsoids of bench_ellipsoids (b = 1/2, I = 2/5 m (smallest semi-axis)^2).
+inline RigidPoint read_point(Args& a) {
+  RigidPoint pt;
+  pt.shape = a.str("shape", "ellipsoid");
+  if (pt.shape != "ellipsoid" && pt.shape != "superquadric")
+    throw std::invalid_argument("shape must be ellipsoid or superquadric");
+  pt.method = a.str("method", "nnl");
+  if (pt.method != "nnl" && pt.method != "cells") throw std::invalid_argument("method must be nnl or cells");
+  pt.spec.n = static_cast<std::size_t>(a.num("N", 256));
+  pt.spec.phi = a.num("phi", 0.5);
+  pt.x0 = a.num("X0", 2.0);
+  const double b = a.num("b", 0.5);
+  pt.p = a.num("p", 2.0);
+  pt.spec.semi_axes = Vec3(pt.x0 * b, b, b);
+  pt.spec.exponents = Vec3(2.0, 2.0, pt.p);
+  pt.spec.inertia = a.num("inertia", 0.4 * pt.spec.mass * hb::sqr(pt.spec.semi_axes.minCoeff()));
+  pt.spec.eps_d = a.num("eps_d", 1e-5);
+  pt.spec.seed = static_cast<std::uint64_t>(a.num("seed", 1));
+  pt.shell = a.num("shell", 0.15);
+  if (pt.shape == "ellipsoid" && pt.p != 2.0) throw std::invalid_argument("p is for superquadrics");
+  return pt;
+}
+
+inline hb::UnitBody unit_body_of(const RigidPoint& pt) {
+  return pt.shape == "ellipsoid" ? hb::UnitBody{} : hb::superquadric_unit_body(pt.spec);
+}
+inline double bounding_radius_of(const RigidPoint& pt) {
+  return pt.shape == "ellipsoid" ? pt.spec.semi_axes.maxCoeff()
+                                 : hb::superquadric_shape(pt.spec).bounding_radius();
+}
+
+// The lattice start's box for this point, or a reason why it has none.
+struct LatticeCheck {
+  bool ok = false;
+  Vec3 L = Vec3::Zero();
+  double phi_max = 0.0;
+  std::string reason;
+};
+inline LatticeCheck check_lattice(const RigidPoint& pt) {
+  LatticeCheck c;
+  const hb::UnitBody unit = unit_body_of(pt);
+  const hb::StretchedLattice lat = hb::stretched_lattice(pt.spec.n, pt.spec.semi_axes, unit);
+  c.phi_max = lat.phi_max;
+  if (pt.spec.phi > lat.phi_max * (1.0 - 1e-12)) {
+    c.reason = "packing fraction above the lattice start's limit " + std::to_string(lat.phi_max);
+    return c;
+  }
+  const double a0 = hb::lattice_constant(pt.spec.n, pt.spec.phi, lat.m, unit);
+  for (int k = 0; k < 3; ++k) c.L[k] = pt.spec.semi_axes[k] * a0 * lat.m[k];
+  // Both neighbour methods need every box side above two interaction ranges (cells) and four
+  // circumradii of the neighbour-list box (minimum-image SAT, neighbors/obb_neighbors.hpp).
+  const double need = std::max(4.0 * bounding_radius_of(pt),
+                               4.0 * (pt.spec.semi_axes + Vec3::Constant(pt.shell)).norm());
+  if (c.L.minCoeff() < need) {
+    c.reason = "box side " + std::to_string(c.L.minCoeff()) + " below " + std::to_string(need);
+    return c;
+  }
+  c.ok = true;
+  return c;
+}
+
+// The smallest N >= the requested one (up to 16x) whose lattice start reaches phi in a box large
+// enough for both neighbour methods; spec.n is set to it.  Returns the check of the last N tried.
+inline LatticeCheck fit_particle_number(RigidPoint& pt) {
+  const std::size_t n0 = pt.spec.n;
+  LatticeCheck c;
+  for (std::size_t n = n0; n <= 16 * n0; n = std::max(n + 4, static_cast<std::size_t>(n * 1.08))) {
+    pt.spec.n = n;
+    c = check_lattice(pt);
+    if (c.ok) return c;
+  }
+  pt.spec.n = n0;
+  return c;
+}
+
+// Counters of a simulation at one moment; differences give the cost of a stretch of events.
+struct Tally {
+  double cpu = 0, wall = 0, collisions = 0, neighbour_events = 0, stale = 0;
+  double predictions = 0, distance_evals = 0, distance_nr = 0, axis_steps = 0, hits = 0,
+         hit_distance_evals = 0, grazing = 0, contact_fallbacks = 0, distance_fallbacks = 0,
+         collision_distance_fallbacks = 0;
+  Tally operator-(const Tally& o) const {
+    Tally d;
+    d.cpu = cpu - o.cpu, d.wall = wall - o.wall, d.collisions = collisions - o.collisions;
+    d.neighbour_events = neighbour_events - o.neighbour_events, d.stale = stale - o.stale;
+    d.predictions = predictions - o.predictions, d.distance_evals = distance_evals - o.distance_evals;
+    d.distance_nr = distance_nr - o.distance_nr, d.axis_steps = axis_steps - o.axis_steps;
+    d.hits = hits - o.hits, d.hit_distance_evals = hit_distance_evals - o.hit_distance_evals;
+    d.grazing = grazing - o.grazing, d.contact_fallbacks = contact_fallbacks - o.contact_fallbacks;
+    d.distance_fallbacks = distance_fallbacks - o.distance_fallbacks;
+    d.collision_distance_fallbacks = collision_distance_fallbacks - o.collision_distance_fallbacks;
+    return d;
+  }
+  Tally& operator+=(const Tally& o) {
+    cpu += o.cpu, wall += o.wall, collisions += o.collisions, neighbour_events += o.neighbour_events;
+    stale += o.stale, predictions += o.predictions, distance_evals += o.distance_evals;
+    distance_nr += o.distance_nr, axis_steps += o.axis_steps, hits += o.hits;
+    hit_distance_evals += o.hit_distance_evals, grazing += o.grazing;
+    contact_fallbacks += o.contact_fallbacks, distance_fallbacks += o.distance_fallbacks;
+    collision_distance_fallbacks += o.collision_distance_fallbacks;
+    return *this;
+  }
+  double fallbacks() const { return contact_fallbacks + distance_fallbacks + collision_distance_fallbacks; }
+};
+
+inline double wall_now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+template <class Sim>
+Tally tally(const Sim& sim) {
+  Tally t;
+  t.cpu = cpu_now();
+  t.wall = wall_now();
+  const auto& e = sim.event_counts();
+  t.collisions = double(sim.collisions());
+  t.neighbour_events = double(e[int(hb::EventType::CellCross)] + e[int(hb::EventType::Rebuild)]);
+  t.stale = double(sim.stale_events());
+  if constexpr (requires { sim.model().stats; }) {
+    const hb::SolverStats& s = sim.model().stats;
+    t.predictions = double(s.predictions), t.distance_evals = double(s.distance_evals);
+    t.distance_nr = double(s.distance_nr_iterations), t.axis_steps = double(s.axis_steps);
+    t.hits = double(s.hits), t.hit_distance_evals = double(s.hit_distance_evals);
+    t.grazing = double(s.grazing_searches), t.contact_fallbacks = double(s.fallbacks);
+    t.distance_fallbacks = double(s.distance_fallbacks);
+    t.collision_distance_fallbacks = double(s.collision_distance_fallbacks);
+  }
+  return t;
+}
+
+// Wall-clock share of each kind of event (collisions with their two re-predictions, neighbour
+// events: cell crossings or list rebuilds with their re-prediction, stale collisions).
+struct Split {
+  double collision = 0, neighbour = 0, stale = 0;
+};
+
+// Runs `count` collisions (stops early once `budget` CPU seconds are spent and at least
+// `min_count` collisions are done).  With `split`, each event is timed by its kind.
+template <class Sim>
+Tally run_collisions(Sim& sim, double count, double budget = hb::kInf, double min_count = 0,
+                     Split* split = nullptr) {
+  const Tally t0 = tally(sim);
+  const double c0 = double(sim.collisions());
+  for (std::uint64_t k = 0; double(sim.collisions()) - c0 < count; ++k) {
+    if (split) {
+      const double w0 = wall_now();
+      const hb::StepInfo info = sim.step(hb::kInf);
+      const double dw = wall_now() - w0;
+      (info.stale ? split->stale : info.type == hb::EventType::Collision ? split->collision : split->neighbour) += dw;
+    } else {
+      sim.step(hb::kInf);
+    }
+    if ((k & 127) == 0 && cpu_now() - t0.cpu > budget && double(sim.collisions()) - c0 >= min_count) break;
+  }
+  return tally(sim) - t0;
+}
+
+// Per-collision figures of a stretch (the keys of bench_ellipsoids, plus a few).
+inline void put_costs(Json& j, const Tally& d) {
+  const double nc = std::max(d.collisions, 1.0), np = std::max(d.predictions, 1.0);
+  j["collisions"] = d.collisions;
+  j["cpu_seconds"] = d.cpu;
+  j["tau_c_us"] = 1e6 * d.cpu / nc;
+  j["collisions_per_second"] = d.collisions / std::max(d.cpu, 1e-12);
+  j["predictions_per_collision"] = d.predictions / nc;
+  j["distance_evals_per_prediction"] = d.distance_evals / np;
+  j["distance_evals_per_collision"] = d.distance_evals / nc;
+  j["distance_nr_iterations_per_eval"] = d.distance_nr / std::max(d.distance_evals, 1.0);
+  j["axis_steps_per_collision"] = d.axis_steps / nc;
+  j["axis_steps_per_prediction"] = d.axis_steps / np;
+  j["neighbour_events_per_collision"] = d.neighbour_events / nc;
+  j["stale_per_collision"] = d.stale / nc;
+  j["hits_per_collision"] = d.hits / nc;
+  j["distance_evals_per_hit"] = d.hit_distance_evals / std::max(d.hits, 1.0);
+  j["grazing_searches_per_collision"] = d.grazing / nc;
+  j["fallbacks"] = d.fallbacks();
+}
+
+// Hard spheres of diameter 1 at the same N and phi (the hard-sphere engine; shell 0: cells).
+inline hb::SphereSystemSpec sphere_spec(std::size_t n, double phi, double shell, std::uint64_t seed) {
+  hb::SphereSystemSpec s;
+  s.n = n;
+  s.phi = phi;
+  s.sigma = 1.0;
+  s.shell = shell;
+  s.seed = seed;
+  return s;
+}
+
+// A configuration to start a simulation from: the lattice start of a point, or the synchronized
+// state of an earlier simulation (every body at time `now`).
+struct Start {
+  hb::Box box;
+  hb::State state;
+  double now = 0.0;
+};
+inline Start lattice_start_of(const RigidPoint& pt) {
+  Start st;
+  st.state = pt.shape == "ellipsoid" ? hb::ellipsoid_start(pt.spec, st.box)
+                                     : hb::superquadric_start(pt.spec, st.box);
+  return st;
+}
+
+// Builds the simulation of a rigid point from `st` and hands it to f (a generic lambda).
+template <class F>
+void with_rigid_simulation(const RigidPoint& pt, Start st, F&& f) {
+  auto build = [&](auto model) {
+    using Model = decltype(model);
+    using S = decltype(model.shape);
+    if (pt.method == "cells") {
+      const hb::CellNeighbors nb(model.interaction_range());
+      f(hb::Simulation<Model, hb::CellNeighbors>(st.box, std::move(st.state), std::move(model), nb, st.now));
+    } else {
+      hb::ObbNeighbors<S> nb(model.shape, pt.shell);
+      f(hb::Simulation<Model, hb::ObbNeighbors<S>>(st.box, std::move(st.state), std::move(model),
+                                                   std::move(nb), st.now));
+    }
+  };
+  if (pt.shape == "ellipsoid")
+    build(hb::ellipsoid_model(pt.spec));
+  else
+    build(hb::superquadric_model(pt.spec));
+}
+
+// main() of a benchmark: bad arguments and unexpected errors exit with status 2 and one message.
+inline int guarded_main(const char* name, int (*run)(int, char**), int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", name, e.what());
+    return 2;
+  }
+}
+
+inline Json describe(const RigidPoint& pt) {
+  Json j;
+  j["shape"] = pt.shape;
+  j["N"] = pt.spec.n;
+  j["phi"] = pt.spec.phi;
+  j["X0"] = pt.x0;
+  j["p"] = pt.p;
+  j["semi_axes"] = {pt.spec.semi_axes.x(), pt.spec.semi_axes.y(), pt.spec.semi_axes.z()};
+  j["exponents"] = {pt.spec.exponents.x(), pt.spec.exponents.y(), pt.spec.exponents.z()};
+  j["inertia"] = pt.spec.inertia;
+  j["method"] = pt.method;
+  j["shell"] = pt.shell;
+  j["eps_d"] = pt.spec.eps_d;
+  j["seed"] = pt.spec.seed;
+  return j;
+}
+
+}  // namespace hbbench
