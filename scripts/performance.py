@@ -222,7 +222,7 @@ def source_of(build):
     info = {"build": os.path.abspath(build), "source": src}
     if os.path.exists(os.path.join(src, "SOURCE_COMMIT")):  # e.g. a `git archive` export
         info["commit"] = open(os.path.join(src, "SOURCE_COMMIT")).read().strip()
-        info["source_note"] = "clean export of the commit (plus the bench/ and scripts/ files of this study)"
+        info["source_note"] = "clean `git archive` export of the commit"
     elif os.path.isdir(os.path.join(src, ".git")):
         info["commit"] = sh(f"git -C '{src}' rev-parse HEAD")
         dirty = sh(f"git -C '{src}' status --porcelain -- src bench")
