@@ -22,6 +22,12 @@
 // unbounded) only K_n.
 // Evaluation: R(t)^T n = R(t_state)^T rot(w, -|w| tau) n (Rodrigues on one vector, tau =
 // t - t_state): two sin/cos and two support functions per value.
+// Growth (both shapes scaled about their centres by s(t) = s0 + sdot tau, contact_time.hpp):
+// the support functions scale, g = n.(r_B - r_A) - s(t) (h_A + h_B), so
+//     g' = n.dv - sdot (h_A + h_B) + s(t) (p_A.(W_A x m_A) + p_B.(W_B x m_B)),
+//     |g'| <= |n.dv| + |sdot| (L_A + L_B) + s_max (L_A |w_A x n| + L_B |w_B x n|),
+//     |g''| <= 2 |sdot| (L_A |w_A x n| + L_B |w_B x n|) + s_max M_rigid        (s'' = 0),
+// s_max the largest scale over the interval considered (`bounds(s_max)`).
 #pragma once
 #include <cmath>
 #include <concepts>
@@ -40,16 +46,21 @@ class AxisGap {
     { y.max_curvature_radius() } -> std::convertible_to<double>;
   };
 
+  // s0, sdot: the common scale law of both shapes (growth); s0 = 1, sdot = 0 for rigid bodies.
   AxisGap(const SA& sa, const BodyState& a, const SB& sb, const BodyState& b, double t_state,
-          const Vec3& n)
-      : sa_(sa), sb_(sb), n_(n), dr_(b.r - a.r), dv_(b.v - a.v), t_state_(t_state) {
+          const Vec3& n, double s0 = 1.0, double sdot = 0.0)
+      : sa_(sa), sb_(sb), n_(n), dr_(b.r - a.r), dv_(b.v - a.v), t_state_(t_state), s0_(s0),
+        sdot_(sdot) {
     const double La = sa.bounding_radius(), Lb = sb.bounding_radius();
     const double swa = a.w.cross(n).norm(), swb = b.w.cross(n).norm();
     wa_ = a.w.norm(), wb_ = b.w.norm();
-    Kn = std::abs(n.dot(dv_)) + La * swa + Lb * swb;
+    ndv_ = std::abs(n.dot(dv_));
+    rot_ = La * swa + Lb * swb;
+    Lsum_ = La + Lb;
     if constexpr (kCurved)
-      M = swa * (sa.max_curvature_radius() * swa + La * wa_) +
-          swb * (sb.max_curvature_radius() * swb + Lb * wb_);
+      Mrigid_ = swa * (sa.max_curvature_radius() * swa + La * wa_) +
+                swb * (sb.max_curvature_radius() * swb + Lb * wb_);
+    bounds(s0);
     RaT_ = a.q.toRotationMatrix().transpose();
     RbT_ = b.q.toRotationMatrix().transpose();
     Wa_ = RaT_ * a.w, Wb_ = RbT_ * b.w;
@@ -57,9 +68,15 @@ class AxisGap {
     kb_ = wb_ > 0.0 ? Vec3(b.w / wb_) : Vec3::Zero();
   }
 
-  double Kn = 0.0;  // bound of |g'|
-  double M = kInf;  // bound of |g''| (kCurved shapes only)
+  double Kn = 0.0;  // bound of |g'| (for scales up to the s_max of the last `bounds` call)
+  double M = kInf;  // bound of |g''| (kCurved shapes only; likewise)
   const Vec3& axis() const { return n_; }
+  double scale_at(double t) const { return s0_ + sdot_ * (t - t_state_); }
+  // Set Kn and M for an interval on which the scale stays <= s_max (rigid: s_max = 1).
+  void bounds(double s_max) {
+    Kn = ndv_ + std::abs(sdot_) * Lsum_ + s_max * rot_;
+    if constexpr (kCurved) M = 2.0 * std::abs(sdot_) * rot_ + s_max * Mrigid_;
+  }
 
   // g(t); slope = g'(t) for kCurved shapes, -Kn otherwise; ma, mb the body-frame directions
   // (their support points are the extreme points along the axis).
@@ -67,13 +84,15 @@ class AxisGap {
     const double tau = t - t_state_;
     ma = RaT_ * back(ka_, wa_, tau);
     mb = -(RbT_ * back(kb_, wb_, tau));
+    const double sc = s0_ + sdot_ * tau;
     if constexpr (kCurved) {
       const Vec3 pa = sa_.support_point(ma), pb = sb_.support_point(mb);
-      slope = n_.dot(dv_) + pa.dot(Wa_.cross(ma)) + pb.dot(Wb_.cross(mb));
-      return n_.dot(dr_ + dv_ * tau) - pa.dot(ma) - pb.dot(mb);
+      const double h = pa.dot(ma) + pb.dot(mb);
+      slope = n_.dot(dv_) - sdot_ * h + sc * (pa.dot(Wa_.cross(ma)) + pb.dot(Wb_.cross(mb)));
+      return n_.dot(dr_ + dv_ * tau) - sc * h;
     } else {
       slope = -Kn;
-      return n_.dot(dr_ + dv_ * tau) - sa_.support(ma) - sb_.support(mb);
+      return n_.dot(dr_ + dv_ * tau) - sc * (sa_.support(ma) + sb_.support(mb));
     }
   }
   double value(double t) const {
@@ -93,8 +112,8 @@ class AxisGap {
   const SA& sa_;
   const SB& sb_;
   Vec3 n_, dr_, dv_;
-  double t_state_;
-  double wa_ = 0.0, wb_ = 0.0;
+  double t_state_, s0_, sdot_;
+  double wa_ = 0.0, wb_ = 0.0, ndv_ = 0.0, rot_ = 0.0, Lsum_ = 0.0, Mrigid_ = 0.0;
   Mat3 RaT_, RbT_;
   Vec3 Wa_, Wb_, ka_, kb_;
 };
@@ -107,19 +126,20 @@ class AxisGap {
 // beta = |c| + (L_A + L_B) / 2 (about the curvature of G on the sphere; the plain fixed point
 // n <- x_B - x_A oscillates), from the line of centres; a step that does not increase the gap
 // is retried at half the length. Returns the best axis, its gap in `gap` (one evaluation per
-// iteration; the search stops early once the gap reaches `enough`). Zero vector if the centres
-// coincide.
+// iteration; the search stops early once the gap reaches `enough`); `scale` scales both shapes
+// (growth). Zero vector if the centres coincide.
 template <SupportShape SA, SupportShape SB>
 Vec3 separating_axis(const SA& sa, const BodyState& a, const SB& sb, const BodyState& b,
-                     double tau, int iterations, double& gap, double enough = kInf) {
+                     double tau, int iterations, double& gap, double enough = kInf,
+                     double scale = 1.0) {
   const Vec3 c = (b.r - a.r) + (b.v - a.v) * tau;
   gap = -kInf;
   if (!(c.squaredNorm() > 0.0)) return Vec3::Zero();
   const Mat3 Ra = rotation_at(a, tau), Rb = rotation_at(b, tau);
-  double beta = c.norm() + 0.5 * (sa.bounding_radius() + sb.bounding_radius());
+  double beta = c.norm() + 0.5 * scale * (sa.bounding_radius() + sb.bounding_radius());
   auto eval = [&](const Vec3& n, Vec3& sep) {
-    const Vec3 xa = Ra * sa.support_point(Vec3(Ra.transpose() * n));
-    const Vec3 xb = Rb * sb.support_point(Vec3(-(Rb.transpose() * n)));
+    const Vec3 xa = scale * (Ra * sa.support_point(Vec3(Ra.transpose() * n)));
+    const Vec3 xb = scale * (Rb * sb.support_point(Vec3(-(Rb.transpose() * n))));
     sep = c + xb - xa;
     return n.dot(sep);
   };

@@ -37,7 +37,8 @@
 //     zero to tolerance; otherwise (fallback, counted) the bracket is shrunk on the sign of
 //     d(t) (Illinois + bisection) and its left end, where d > 0, is returned: a time never later
 //     than the contact.
-//  Separating-axis advancement (beyond the paper; shapes with a support function, no growth).
+//  Separating-axis advancement (beyond the paper; shapes with a support function; with growth
+//  the gap and its bounds carry the scale law, axis_gap.hpp).
 //  The gap g_n(t) along a fixed unit vector n (contact/axis_gap.hpp) is a lower bound of the
 //  distance that costs two support functions instead of a distance solve, with the rate bound
 //  |g_n'| <= K_n <= K and, for shapes with bounded curvature, |g_n''| <= M.  It is advanced by
@@ -408,7 +409,8 @@ struct Solver {
   // contact/axis_gap.hpp).
   double advance_on_axis(const Vec3& n, double t0, double hi) {
     using Gap = AxisGap<SA, SB>;
-    const Gap G(in.shape_a, in.a, in.shape_b, in.b, in.t_state, n);
+    Gap G(in.shape_a, in.a, in.shape_b, in.b, in.t_state, n, grow ? in.growth.s : 1.0,
+          grow ? in.growth.rate : 0.0);
     // Second-order steps converge on the gap's zero: follow it closer than eps_d. They also
     // leave a touching pair that separates (g ~ 0, g' > 0: just after its collision): the
     // parabola g + g' dt - M dt^2 / 2 stays positive up to (g' + q) / M. A gap negative at
@@ -423,6 +425,15 @@ struct Solver {
       if (!(g >= floor || leaving)) break;
       // no zero of g before t + dt: first order g - Kn dt > 0, or second order
       // g + g' dt - M dt^2 / 2 > 0 (the positive root, written without cancellation)
+      // Growth: the bounds hold for scales up to s_max, the larger end of [t, t + span]
+      // (span: the rest of the window, or 10 first-order steps if it is unbounded); the step
+      // stays inside the span.
+      double span = kInf;
+      if (grow) {
+        G.bounds(G.scale_at(t));
+        span = hi < kInf ? hi - t : 10.0 * std::max(g, in.eps_d) / G.Kn;
+        G.bounds(std::max(G.scale_at(t), G.scale_at(t + span)));
+      }
       double dt = std::max(g, 0.0) / G.Kn;  // Kn = 0: the gap never changes, no contact
       if constexpr (Gap::kCurved) {
         const double q = std::sqrt(std::max(slope * slope + 2.0 * G.M * g, 0.0));
@@ -430,6 +441,7 @@ struct Solver {
             slope <= 0.0 ? 2.0 * g / (q - slope) : (G.M > 0.0 ? (slope + q) / G.M : kInf);
         dt = std::max(dt, dt2);
       }
+      dt = std::min(dt, span);
       if (!(dt > 0.0)) break;
       const double t1 = t + dt;
       if (!(t1 < hi)) return hi;
@@ -534,13 +546,14 @@ struct Solver {
       // Before any distance solve: advance along the line of centres (a pair that cannot
       // meet inside the window usually costs no distance solve at all).
       // Re-aim the axis where the gap ran low, as long as that makes progress.
-      for (int k = 0; k < 8 && o.separating_axis && !grow; ++k) {
+      for (int k = 0; k < 8 && o.separating_axis; ++k) {
         // a gap of K (hi - lo) already rules out any contact in the window
+        const double reach = hi < kInf ? (grow ? rate_bound(lo, hi) : K) * (hi - lo) : kInf;
         double g0;
         const Vec3 n = separating_axis(in.shape_a, in.a, in.shape_b, in.b, lo - in.t_state, 3, g0,
-                                       K * (hi - lo));
+                                       reach, grow ? A.scale_at(lo) : 1.0);
         if (!(n.squaredNorm() > 0.0)) break;
-        if (g0 >= K * (hi - lo)) return;  // none
+        if (g0 >= reach) return;  // none
         const double t = advance_on_axis(n, lo, hi);
         if (!(t < hi)) return;  // none
         if (!(t > lo)) break;
@@ -548,9 +561,12 @@ struct Solver {
       }
       // The support points along the last axis are close to the closest points: the first
       // distance solve starts from them instead of the cold guess.
-      if (o.separating_axis && !grow && !warm.valid && axis_ma.squaredNorm() > 0.0)
-        warm = DistanceWarmStart{in.shape_a.support_point(axis_ma), in.shape_b.support_point(axis_mb),
-                                 1.0, 0.0, true};
+      if (o.separating_axis && !warm.valid && axis_ma.squaredNorm() > 0.0) {
+        const double sc = grow ? A.scale_at(lo) : 1.0;
+        warm = DistanceWarmStart{sc * in.shape_a.support_point(axis_ma),
+                                 sc * in.shape_b.support_point(axis_mb), 1.0, 0.0, true};
+        warm_scale = sc;
+      }
     }
     Sample s = eval(lo);
     if (failed) return;
@@ -562,7 +578,7 @@ struct Solver {
     if (K == 0.0) return;  // no relative motion: the distance never changes
     while (s.t < hi) {
       if constexpr (kAxis) {
-        if (o.separating_axis && !grow && (s.d >= in.eps_d || (kCurved && s.dd > 0.0))) {
+        if (o.separating_axis && (s.d >= in.eps_d || (kCurved && s.dd > 0.0))) {
           const double t = advance_on_axis(s, hi);
           if (!(t < hi)) break;
           if (t > s.t) {
