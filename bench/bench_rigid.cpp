@@ -16,16 +16,21 @@
 // Bodies: semi-axes (X0 b, b, b) along body x, y, z; superquadric exponents (2, 2, p) as in the
 // paper's section 5.  Prints one JSON line per measurement; status "ok", "skipped" (state not
 // reachable by the lattice start, with the reason) or "failed" (a solver failure or an overlap,
-// with the message; the rest of a scan is then skipped).
+// with the message; the next point of a scan then starts afresh from the lattice, with the full
+// warm-up).
 #include <cstdio>
 #include <exception>
+#include <regex>
 #include <string>
 #include <vector>
+
+#include <fmt/format.h>
 
 #include "io/checkpoint.hpp"
 #include "observers/overlap.hpp"
 #include "observers/overlap_sampling.hpp"
 #include "observers/structure.hpp"
+#include "shapes/describe.hpp"
 
 #include "bench_rigid.hpp"
 
@@ -38,6 +43,24 @@ namespace {
 hb::OverlapReport overlaps_of(const hb::State& s, const hb::Box& box, const RigidPoint& pt) {
   if (pt.shape == "ellipsoid") return hb::ellipsoid_overlaps(s.r, s.q, box, pt.spec.semi_axes);
   return hb::superquadric_overlaps(s.r, s.q, box, hb::superquadric_shape(pt.spec));
+}
+
+// A `hardbody distance` input line for the pair that a failure message names ("... i and j"),
+// in the state where the run stopped (both bodies at the failure time), or "" if none is named.
+template <class Shape>
+std::string pair_reproducer(const std::string& msg, const Start& st, const Shape& shape) {
+  static const std::regex ids("(\\d+) and (\\d+)");
+  std::smatch m;
+  if (!std::regex_search(msg, m, ids)) return "";
+  const std::size_t i = std::stoul(m[1]), j = std::stoul(m[2]);
+  if (i >= st.state.size() || j >= st.state.size()) return "";
+  auto body = [&](const Vec3& r, const hb::Quat& q) {
+    return fmt::format("{{\"shape\": {}, \"position\": [{:.17g}, {:.17g}, {:.17g}], "
+                       "\"orientation\": [{:.17g}, {:.17g}, {:.17g}, {:.17g}]}}",
+                       hb::shape_json(shape), r.x(), r.y(), r.z(), q.w(), q.x(), q.y(), q.z());
+  };
+  const Vec3 rj = st.state.r[i] + st.box.near_image(st.state.r[j] - st.state.r[i]);
+  return fmt::format("{{\"a\": {}, \"b\": {}}}", body(st.state.r[i], st.state.q[i]), body(rj, st.state.q[j]));
 }
 
 struct Scan {
@@ -97,7 +120,7 @@ int run(int argc, char** argv) {
   const double warm = std::max(warm_given, warm_pp * double(pt.spec.n));
   Start st;
   if (lat.ok) st = lattice_start_of(pt);
-  std::string failure;
+  bool fresh = true;  // st is the lattice start: warm up in full
   for (std::size_t k = 0; k < values.size(); ++k) {
     const RigidPoint q = scan.key.empty() ? pt : with_value(pt, scan, values[k]);
     Json j;
@@ -105,19 +128,20 @@ int run(int argc, char** argv) {
     j.update(describe(q));
     j["N_requested"] = n_requested;
     if (!scan.key.empty()) j["scan"] = scan.key, j["scan_index"] = k;
-    if (!lat.ok || !failure.empty()) {
+    if (!lat.ok) {
       j["status"] = "skipped";
-      j["reason"] = !lat.ok ? lat.reason : "an earlier point of the scan failed";
+      j["reason"] = lat.reason;
       std::printf("%s\n", j.dump().c_str());
       continue;
     }
     j["box"] = {st.box.L.x(), st.box.L.y(), st.box.L.z()};
+    std::string failure;
     with_rigid_simulation(q, std::move(st), [&](auto sim) {
       Tally warm_t, meas_t;
       Split sp;
       const Tally start = tally(sim);
       try {
-        warm_t = run_collisions(sim, k == 0 ? warm : rewarm);
+        warm_t = run_collisions(sim, fresh ? warm : rewarm);
         meas_t = run_collisions(sim, coll, budget, min_coll, split ? &sp : nullptr);
         j["status"] = "ok";
       } catch (const std::exception& e) {
@@ -138,6 +162,7 @@ int run(int argc, char** argv) {
       }
       st = Start{sim.box(), hb::synchronized_state(sim), sim.now()};
       j["S2"] = hb::nematic_order(st.state.q, Vec3::UnitX()).S2;
+      if (!failure.empty()) j["reproducer"] = pair_reproducer(failure, st, sim.model().shape);
       if (check) {
         const hb::OverlapReport rep = overlaps_of(st.state, st.box, q);
         j["overlaps"] = rep.overlaps;
@@ -151,6 +176,8 @@ int run(int argc, char** argv) {
     });
     std::printf("%s\n", j.dump().c_str());
     std::fflush(stdout);
+    fresh = !failure.empty();
+    if (fresh) st = lattice_start_of(pt);
   }
   return 0;
 }
