@@ -142,7 +142,8 @@ def plan(run, c):
                 collisions=c["f_coll"], budget=c["f_budget"], scan=methods)
     for x0 in c["f_x0"]:
         for p in c["f_long_p"]:
-            run("bench_rigid", "f_long", **SQ, X0=x0, b=sq_b(x0), p=p, warmup=c["f_warm"],
+            # another seed than (f): an independent trajectory
+            run("bench_rigid", "f_long", **SQ, X0=x0, b=sq_b(x0), p=p, seed=2, warmup=c["f_warm"],
                 collisions=c["f_long_coll"], method="nnl")
     run("bench_ratio", "f_ratio", pair="superquadric", N=512, phi=0.256, X0=2, b=sq_b(2.0),
         inertia=1, eps_d="1e-5", shell=0.15, collisions=c["f_ratio_coll"], warmup=c["f_ratio_warm"],
