@@ -86,7 +86,7 @@ superquadric_config() {
 [system]
 particles = 512
 packing_fraction = 0.256
-seed = 1
+seed = ${SEED:-1}
 [shape]
 type = "superquadric"
 semi_axes = [$axes]
@@ -146,11 +146,18 @@ case "$group" in
     done ;;
   sq-vs-ellipsoid)
     # the ellipsoid at the state of sq_X0_2_p2_nnl (superquadrics group: N = 512, phi = 0.256,
-    # semi-axes 1.6, 0.8, 0.8, I = 1, same seed, start and collision count); SQ_X0 = 0.5 for oblate
+    # semi-axes 1.6, 0.8, 0.8, I = 1, same seed, start and collision count); SQ_X0 = 0.5 for
+    # oblate; SEEDS ("1"): other seeds run a further pair, superquadric [2, 2, 2] and ellipsoid
     for x0 in ${SQ_X0:-2}; do
-      superquadric_config "sqe_el_X0_$x0" "$x0" 2.0 nnl 2.0 && \
-        sed -i -e 's/^type = "superquadric"/type = "ellipsoid"/' -e '/^exponents/d' \
-          "$work/sqe_el_X0_$x0.toml" && run "sqe_el_X0_$x0"
+      for seed in ${SEEDS:-1}; do
+        if [ "$seed" = 1 ]; then sfx=""; else
+          sfx=_s$seed
+          SEED=$seed superquadric_config "sqe_sq_X0_$x0$sfx" "$x0" 2.0 nnl 2.0 && run "sqe_sq_X0_$x0$sfx"
+        fi
+        SEED=$seed superquadric_config "sqe_el_X0_$x0$sfx" "$x0" 2.0 nnl 2.0 && \
+          sed -i -e 's/^type = "superquadric"/type = "ellipsoid"/' -e '/^exponents/d' \
+            "$work/sqe_el_X0_$x0$sfx.toml" && run "sqe_el_X0_$x0$sfx"
+      done
     done ;;
   tables) ;;
   *) echo "unknown group '$group' (ellipsoids, ellipsoids-045, superquadrics, sq-taus, sq-vs-ellipsoid, tables)" >&2
@@ -190,6 +197,25 @@ def fb(s):
     v = s["solver"]
     return (f"{s['solver_fallbacks']} (dist {v['distance_fallbacks']}, coll-dist "
             f"{v['collision_distance_fallbacks']}, contact {v['contact_fallbacks']})")
+
+def failed(prefix):
+    """Runs of failures.md named PREFIX*, with how far they got (runs/NAME.failed.json)."""
+    res, text = {}, open(f"{out}/failures.md").read() if os.path.exists(f"{out}/failures.md") else ""
+    for part in text.split("## ")[1:]:
+        head, body = part.split("\n", 1)
+        name, rc = head.split(": exit ")
+        if not name.startswith(prefix):
+            continue
+        keep = f"{out}/runs/{name}.failed.json"
+        msg = [l for l in body.split("\n") if l.startswith("hardbody:")]
+        f = {"exit": int(rc.split()[0]), "message": msg[-1] if msg else ""}
+        part_log = f"{work}/{name}/log.tsv.part"
+        if os.path.exists(part_log):
+            last = open(part_log).read().strip().split("\n")[-1].split("\t")
+            f.update(time=float(last[0]), collisions=int(float(last[1])))
+            json.dump(f, open(keep, "w"), indent=1)
+        res[name] = json.load(open(keep)) if os.path.exists(keep) else f
+    return res
 
 def write(name, lines):
     open(f"{out}/{name}", "w").write("\n".join(lines) + "\n")
@@ -257,13 +283,24 @@ for s, _ in sqrows("sq_X0_*"):
                 f"{s['snapshot_overlaps']} | {s['trajectory_frames']} | {s['min_distance']:.1e} / {s['snapshot_min_distance']:.1e} | "
                 f"{s['energy_drift']:.1e} | {fb(s)} | {s['Z']:.4f} ± {s['Z_error']:.4f} | {s['tau_c_us']:.0f} | {s['cpu_seconds']:.0f} |")
 rows += ["", "## Exponents [2, 2, 2] against the ellipsoid (same state, seed, start and collision count)", "",
-         "| X0 | shape | collisions | Z | collision rate | tau_c (us) |", "|---|---|---|---|---|---|"]
+         "| X0 | seed | shape | collisions | Z | collision rate | tau_c (us) |", "|---|---|---|---|---|---|---|"]
 for x0 in ["2", "0.5"]:
-    for name, label in [(f"sq_X0_{x0}_p2_nnl", "superquadric [2, 2, 2]"), (f"sqe_el_X0_{x0}", "ellipsoid")]:
-        s = load(f"{out}/runs/{name}.summary.json")
-        if s:
-            rows.append(f"| {x0} | {label} | {s['collisions']} | {s['Z']:.4f} ± {s['Z_error']:.4f} | "
-                        f"{s['collision_rate']:.3f} ± {s['collision_rate_error']:.3f} | {s['tau_c_us']:.0f} |")
+    pairs = [(f"sq_X0_{x0}_p2_nnl", f"sqe_el_X0_{x0}")]
+    for f in sorted(glob.glob(f"{out}/runs/sqe_sq_X0_{x0}_s*.summary.json")):
+        sfx = f.split(f"sqe_sq_X0_{x0}")[1].split(".summary")[0]
+        pairs.append((f"sqe_sq_X0_{x0}{sfx}", f"sqe_el_X0_{x0}{sfx}"))
+    for names in pairs:
+        for name, label in zip(names, ["superquadric [2, 2, 2]", "ellipsoid"]):
+            s = load(f"{out}/runs/{name}.summary.json")
+            if s:
+                rows.append(f"| {x0} | {s['seed']} | {label} | {s['collisions']} | {s['Z']:.4f} ± {s['Z_error']:.4f} | "
+                            f"{s['collision_rate']:.3f} ± {s['collision_rate_error']:.3f} | {s['tau_c_us']:.0f} |")
+fails = failed("sq")
+if fails:
+    rows += ["", "## Failed runs (exit 3; reproducer: `hardbody run CONFIG --out DIR --resume` from the checkpoint the run wrote, details in failures.md)", "",
+             "| run | exit | collisions reached (measured) | sim. time reached | message |", "|---|---|---|---|---|"]
+    for name, f in sorted(fails.items()):
+        rows.append(f"| {name} | {f['exit']} | {f.get('collisions', '-')} | {f.get('time', '-')} | {f['message']} |")
 taus = sqrows("sqtau_p*")
 if taus:
     rows += ["", "## Short runs for tau_c (scripts/validate.sh sq-taus: X0 = 2, NNL, snapshots every time unit)", "",
