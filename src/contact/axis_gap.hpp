@@ -17,9 +17,9 @@
 // |m''| = |w| s. With the support Hessian bounded by the largest principal radius of curvature
 // rho (m'^T H m' <= rho |m'|^2) and |p| <= L,
 //     |d^2 h(m(t)) / dt^2| <= rho s^2 + L |w| s,
-// so |g_n''| <= M = sum over the bodies of s (rho s + L |w|). Shapes that provide
-// max_curvature_radius() (ellipsoids, spheres) get M; others (superquadrics: flat faces, rho
-// unbounded) only K_n.
+// so |g_n''| <= M = sum over the bodies of s (rho s + L |w|). Shapes whose
+// max_curvature_radius() is finite (ellipsoids, spheres, superquadrics with all exponents 2) get
+// M; others (superquadrics with an exponent > 2: flat faces, rho unbounded) only K_n.
 // Evaluation: R(t)^T n = R(t_state)^T rot(w, -|w| tau) n (Rodrigues on one vector, tau =
 // t - t_state): two sin/cos and two support functions per value.
 // Growth (both shapes scaled about their centres by s(t) = s0 + sdot tau, contact_time.hpp):
@@ -41,24 +41,32 @@ namespace hb {
 template <SupportShape SA, SupportShape SB>
 class AxisGap {
  public:
-  static constexpr bool kCurved = requires(const SA& x, const SB& y) {
+  static constexpr bool kMayCurve = requires(const SA& x, const SB& y) {
     { x.max_curvature_radius() } -> std::convertible_to<double>;
     { y.max_curvature_radius() } -> std::convertible_to<double>;
   };
+  // Both curvature radii bounded: second-order steps (M finite).
+  static bool curved(const SA& sa, const SB& sb) {
+    if constexpr (kMayCurve)
+      return std::isfinite(sa.max_curvature_radius()) && std::isfinite(sb.max_curvature_radius());
+    else
+      return false;
+  }
 
   // s0, sdot: the common scale law of both shapes (growth); s0 = 1, sdot = 0 for rigid bodies.
   AxisGap(const SA& sa, const BodyState& a, const SB& sb, const BodyState& b, double t_state,
           const Vec3& n, double s0 = 1.0, double sdot = 0.0)
       : sa_(sa), sb_(sb), n_(n), dr_(b.r - a.r), dv_(b.v - a.v), t_state_(t_state), s0_(s0),
-        sdot_(sdot) {
+        sdot_(sdot), curved_(curved(sa, sb)) {
     const double La = sa.bounding_radius(), Lb = sb.bounding_radius();
     const double swa = a.w.cross(n).norm(), swb = b.w.cross(n).norm();
     wa_ = a.w.norm(), wb_ = b.w.norm();
     ndv_ = std::abs(n.dot(dv_));
     rot_ = La * swa + Lb * swb;
     Lsum_ = La + Lb;
-    if constexpr (kCurved)
-      Mrigid_ = swa * (sa.max_curvature_radius() * swa + La * wa_) +
+    if constexpr (kMayCurve)
+      if (curved_)
+        Mrigid_ = swa * (sa.max_curvature_radius() * swa + La * wa_) +
                 swb * (sb.max_curvature_radius() * swb + Lb * wb_);
     bounds(s0);
     RaT_ = a.q.toRotationMatrix().transpose();
@@ -69,23 +77,24 @@ class AxisGap {
   }
 
   double Kn = 0.0;  // bound of |g'| (for scales up to the s_max of the last `bounds` call)
-  double M = kInf;  // bound of |g''| (kCurved shapes only; likewise)
+  double M = kInf;  // bound of |g''| (curved() pairs only; likewise)
+  bool is_curved() const { return curved_; }
   const Vec3& axis() const { return n_; }
   double scale_at(double t) const { return s0_ + sdot_ * (t - t_state_); }
   // Set Kn and M for an interval on which the scale stays <= s_max (rigid: s_max = 1).
   void bounds(double s_max) {
     Kn = ndv_ + std::abs(sdot_) * Lsum_ + s_max * rot_;
-    if constexpr (kCurved) M = 2.0 * std::abs(sdot_) * rot_ + s_max * Mrigid_;
+    if (curved_) M = 2.0 * std::abs(sdot_) * rot_ + s_max * Mrigid_;
   }
 
-  // g(t); slope = g'(t) for kCurved shapes, -Kn otherwise; ma, mb the body-frame directions
+  // g(t); slope = g'(t) for curved() pairs, -Kn otherwise; ma, mb the body-frame directions
   // (their support points are the extreme points along the axis).
   double value(double t, double& slope, Vec3& ma, Vec3& mb) const {
     const double tau = t - t_state_;
     ma = RaT_ * back(ka_, wa_, tau);
     mb = -(RbT_ * back(kb_, wb_, tau));
     const double sc = s0_ + sdot_ * tau;
-    if constexpr (kCurved) {
+    if (curved_) {
       const Vec3 pa = sa_.support_point(ma), pb = sb_.support_point(mb);
       const double h = pa.dot(ma) + pb.dot(mb);
       slope = n_.dot(dv_) - sdot_ * h + sc * (pa.dot(Wa_.cross(ma)) + pb.dot(Wb_.cross(mb)));
@@ -113,6 +122,7 @@ class AxisGap {
   const SB& sb_;
   Vec3 n_, dr_, dv_;
   double t_state_, s0_, sdot_;
+  bool curved_;
   double wa_ = 0.0, wb_ = 0.0, ndv_ = 0.0, rot_ = 0.0, Lsum_ = 0.0, Mrigid_ = 0.0;
   Mat3 RaT_, RbT_;
   Vec3 Wa_, Wb_, ka_, kb_;

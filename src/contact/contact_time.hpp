@@ -394,10 +394,11 @@ struct Solver {
   }
 
   static constexpr bool kAxis = SupportShape<SA> && SupportShape<SB>;
-  static constexpr bool kCurved = [] {
-    if constexpr (kAxis) return AxisGap<SA, SB>::kCurved;
+  // Second-order axis steps (both curvature radii finite, AxisGap::curved).
+  bool curved_axes() const {
+    if constexpr (kAxis) return AxisGap<SA, SB>::curved(in.shape_a, in.shape_b);
     else return false;
-  }();
+  }
 
   // Separating-axis advancement from sample s (d >= eps_d, see the header): the time up to
   // which no contact is possible, >= hi if none in the window.
@@ -415,13 +416,13 @@ struct Solver {
     // leave a touching pair that separates (g ~ 0, g' > 0: just after its collision): the
     // parabola g + g' dt - M dt^2 / 2 stays positive up to (g' + q) / M. A gap negative at
     // rounding level (-1e-12 L, the solver's noise guard) counts as touching.
-    const double floor = Gap::kCurved ? 1e-3 * in.eps_d : in.eps_d;
+    const double floor = G.is_curved() ? 1e-3 * in.eps_d : in.eps_d;
     const double noise = -1e-12 * L;
     double t = t0, slope = 0.0;
     double g = G.value(t, slope, axis_ma, axis_mb);
     ++out.axis_steps;
     for (int k = 0; k < 64; ++k) {
-      const bool leaving = Gap::kCurved && slope > 0.0 && g >= noise;
+      const bool leaving = G.is_curved() && slope > 0.0 && g >= noise;
       if (!(g >= floor || leaving)) break;
       // no zero of g before t + dt: first order g - Kn dt > 0, or second order
       // g + g' dt - M dt^2 / 2 > 0 (the positive root, written without cancellation)
@@ -435,7 +436,7 @@ struct Solver {
         G.bounds(std::max(G.scale_at(t), G.scale_at(t + span)));
       }
       double dt = std::max(g, 0.0) / G.Kn;  // Kn = 0: the gap never changes, no contact
-      if constexpr (Gap::kCurved) {
+      if (G.is_curved()) {
         const double q = std::sqrt(std::max(slope * slope + 2.0 * G.M * g, 0.0));
         const double dt2 =
             slope <= 0.0 ? 2.0 * g / (q - slope) : (G.M > 0.0 ? (slope + q) / G.M : kInf);
@@ -578,7 +579,7 @@ struct Solver {
     if (K == 0.0) return;  // no relative motion: the distance never changes
     while (s.t < hi) {
       if constexpr (kAxis) {
-        if (o.separating_axis && (s.d >= in.eps_d || (kCurved && s.dd > 0.0))) {
+        if (o.separating_axis && (s.d >= in.eps_d || (s.dd > 0.0 && curved_axes()))) {
           const double t = advance_on_axis(s, hi);
           if (!(t < hi)) break;
           if (t > s.t) {

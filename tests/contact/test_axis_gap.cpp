@@ -127,21 +127,55 @@ TEST(AxisGap, SeparatingAxisSearchApproachesTheDistance) {
 }
 
 TEST(AxisGap, SuperquadricsUseTheFirstOrderBound) {
-  static_assert(!AxisGap<Superquadric, Superquadric>::kCurved);
-  static_assert(AxisGap<Ellipsoid, Sphere>::kCurved);
-  Rng r(53);
+  static_assert(AxisGap<Ellipsoid, Sphere>::kMayCurve);
   const Superquadric q{1.0, 0.5, 0.5, 8.0, 8.0, 8.0};
+  EXPECT_FALSE((AxisGap<Superquadric, Superquadric>::curved(q, q)));  // flat faces
+  EXPECT_FALSE((AxisGap<Superquadric, Superquadric>::curved(q, Superquadric{1, 1, 1, 2, 2, 3})));
+  Rng r(53);
   const int n = scaled_count(500, 0.1);
   double worst = 0.0;
   for (int k = 0; k < n; ++k) {
     const BodyState a{Vec3::Zero(), r.quat(), r.ball(1.0), r.ball(3.0)};
     const BodyState b{Vec3(2.5, 0, 0) + r.ball(0.3), r.quat(), r.ball(1.0), r.ball(3.0)};
     const AxisGap<Superquadric, Superquadric> g(q, a, q, b, 0.0, r.unit());
+    EXPECT_FALSE(g.is_curved());
     const double t = r.uni(-0.2, 0.2), h = 1e-6;
     worst = std::max(worst, std::abs(g.value(t + h) - g.value(t - h)) / (2 * h) / g.Kn);
   }
   std::printf("  %d superquadric axes: max |FD g'| / Kn %.3f\n", n, worst);
   EXPECT_LE(worst, 1.0 + 1e-6);
+}
+
+// A superquadric with all exponents 2 is an ellipsoid: finite curvature radius, second-order
+// steps; its gap, rate and curvature bound equal the ellipsoid's on random axes.
+TEST(AxisGap, SuperquadricWithExponentsTwoIsCurvedLikeTheEllipsoid) {
+  Rng r(61);
+  const int n = scaled_count(1000, 0.1);
+  double worst_gap = 0.0, worst_rate = 0.0, worst_curv = 0.0;
+  for (int k = 0; k < n; ++k) {
+    const Pair p = random_pair(r, r.log_uni(1e-3, 2.0));
+    const Superquadric qa{p.a.a, p.a.b, p.a.c, 2, 2, 2}, qb{p.b.a, p.b.b, p.b.c, 2, 2, 2};
+    ASSERT_NEAR(qa.max_curvature_radius(), p.a.max_curvature_radius(), 1e-15);
+    const Vec3 axis = r.unit();
+    const AxisGap<Superquadric, Superquadric> g(qa, p.sa, qb, p.sb, 0.0, axis);
+    const AxisGap<Ellipsoid, Ellipsoid> ge(p.a, p.sa, p.b, p.sb, 0.0, axis);
+    ASSERT_TRUE(g.is_curved());
+    const double t = r.uni(-0.9, 0.9), h = 1e-5;
+    double slope, slope_e;
+    Vec3 ma, mb;
+    const double g0 = g.value(t, slope, ma, mb), ge0 = ge.value(t, slope_e, ma, mb);
+    const double L = std::max(p.a.bounding_radius(), p.b.bounding_radius());
+    worst_gap = std::max(worst_gap, std::abs(g0 - ge0) / L);
+    worst_rate = std::max(worst_rate, std::abs(slope - slope_e) / g.Kn);
+    const double gp = g.value(t + h), gm = g.value(t - h);
+    worst_curv = std::max(worst_curv, std::abs((gp - 2 * g0 + gm) / (h * h)) / g.M);
+    EXPECT_NEAR(g.M, ge.M, 1e-12 * ge.M);
+  }
+  std::printf("  %d axes: max |g_sq - g_ell| / L %.2e, max |g'_sq - g'_ell| / Kn %.2e, "
+              "max |FD g''| / M %.3f\n", n, worst_gap, worst_rate, worst_curv);
+  EXPECT_LE(worst_gap, 1e-13);
+  EXPECT_LE(worst_rate, 1e-12);
+  EXPECT_LE(worst_curv, 1.0 + 1e-3);
 }
 
 }  // namespace

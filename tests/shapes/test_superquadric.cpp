@@ -92,7 +92,7 @@ TEST(Superquadric, DerivativesMatchFiniteDifferences) {
 }
 
 TEST(Superquadric, FiniteEverywhereAndOnCoordinatePlanes) {
-  for (const Superquadric s : {Superquadric{1.0, 0.5, 2.0, 20, 2, 40},
+  for (const Superquadric& s : {Superquadric{1.0, 0.5, 2.0, 20, 2, 40},
                                Superquadric{0.3, 1.0, 1.0, 100, 100, 2.5},
                                Superquadric{1.0, 1.0, 1.0, 2, 2, 2}}) {
     for (const Vec3& x : {Vec3(1e-5, 0, 0), Vec3(0, 0, 1e-5), Vec3(1e-8, 0.5, 0),
@@ -235,7 +235,10 @@ TEST(Superquadric, SupportFunction) {
         const double h = std::min(1e-6 * d.norm(), 1e-4 * std::abs(d[i]));
         Vec3 e = Vec3::Zero();
         e[i] = h;
-        EXPECT_NEAR((s.support(d + e) - s.support(d - e)) / (2 * h), x[i], 1e-8 * L);
+        // truncation ~1e-8 relative; rounding: each support value is good to the 1e-14 L |d|
+        // asserted above, so the quotient to 1e-14 L |d| / h
+        EXPECT_NEAR((s.support(d + e) - s.support(d - e)) / (2 * h), x[i],
+                    1e-8 * L + 1e-14 * L * d.norm() / h);
         hfd.col(i) = (s.support_point(d + e) - s.support_point(d - e)) / (2 * h);
       }
       const Mat3 H = s.support_hessian(d);

@@ -1,0 +1,158 @@
+// Contact time of approaching face-to-face superquadrics (p = 4, 8, 12, 16, 20, X0 = 0.5 and 2,
+// all exponents p), where the distance solver meets flat faces at every step.
+//
+// Pure translation along the common face normal n: B is placed at the exact distance `gap`
+// along n (testing::place_at_distance) and moves towards A with the closing speed v.  The
+// separation along n, n.(r_B - r_A) - h_A(n) - h_B(-n), then decreases as gap - v t, and n stays
+// its maximiser (its gradient, x_B(-n) - x_A(n), does not change under translation), so the
+// contact is at exactly t = gap / v, for aligned and for tilted bodies.  Spinning both bodies
+// about n through their centres leaves h_A(n) and h_B(-n) unchanged, so that time holds too.
+// Small spins about random axes: the conservative-advancement reference
+// (tests/contact/reference_contact_time.hpp, support-function distance) gives the time.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <string>
+
+#include "contact/contact_time.hpp"
+#include "contact/reference_contact_time.hpp"
+#include "geometry/random_pairs.hpp"
+#include "shapes/superquadric.hpp"
+
+namespace hb {
+namespace {
+
+using testing::Rng;
+using testing::scaled_count;
+
+// Semi-axes (1.6, 0.8, 0.8) for X0 = 2 (a bar), (0.8, 1.6, 1.6) for X0 = 0.5 (a slab).
+Superquadric body(double p, double X0) {
+  return X0 > 1 ? Superquadric{1.6, 0.8, 0.8, p, p, p} : Superquadric{0.8, 1.6, 1.6, p, p, p};
+}
+
+struct Approach {
+  Superquadric a, b;
+  BodyState sa, sb;
+  Vec3 n;      // A's face normal, the contact normal
+  double gap;  // initial distance
+  double v;    // closing speed along n
+};
+
+// A with a random pose and drift velocity; B's axes along A's (each turned by a random
+// multiple of 90 deg), tilted by `tilt` rad about a random axis, `gap` away along the normal of
+// a random face of A, moving towards it at speed v in [0.3, 2].
+Approach make_approach(Rng& r, double p, double X0a, double X0b, double tilt, double gap) {
+  Approach s{body(p, X0a), body(p, X0b), {}, {}, {}, gap, r.uni(0.3, 2.0)};
+  const Pose pa{r.ball(1.0), r.rotation()};
+  Mat3 Rb = pa.R;
+  for (int i = 0; i < 3; ++i)
+    Rb = Rb * Eigen::AngleAxisd(0.5 * kPi * static_cast<int>(r.uni(0, 4)), Vec3::Unit(i))
+                  .toRotationMatrix();
+  Rb = testing::small_rotation(r, tilt) * Rb;
+  s.n = (r.uni(0, 1) < 0.5 ? -1.0 : 1.0) * pa.R.col(static_cast<int>(r.uni(0, 3)));
+  const Pose pb = testing::place_at_distance(s.a, pa, s.b, Rb, s.n, gap);
+  s.sa = BodyState{pa.r, Quat(pa.R), r.ball(0.5), Vec3::Zero()};
+  s.sb = BodyState{pb.r, Quat(pb.R), s.sa.v - s.v * s.n, Vec3::Zero()};
+  return s;
+}
+
+struct Counts {
+  int n = 0, hits = 0, failed = 0, none = 0, distance_fallbacks = 0, contact_fallbacks = 0;
+  long distance_evals = 0, distance_nr = 0;
+  double max_rel = 0;
+  void add(const ContactResult& c) {
+    ++n;
+    if (c.status == ContactStatus::hit) ++hits;
+    if (c.status == ContactStatus::failed) ++failed;
+    if (c.status == ContactStatus::none) ++none;
+    distance_fallbacks += c.distance_fallbacks;
+    contact_fallbacks += c.fallbacks;
+    distance_evals += c.distance_evals;
+    distance_nr += c.distance_nr_iterations;
+  }
+  void print(const char* name) const {
+    std::printf("  %-12s pairs %4d hit %4d none %d failed %d  max |t - t_exact| / t %.1e  "
+                "distance evals/pair %.1f (NR it./eval %.2f, fallbacks %d)  contact-NR "
+                "fallbacks %d\n",
+                name, n, hits, none, failed, max_rel, double(distance_evals) / std::max(n, 1),
+                double(distance_nr) / std::max(distance_evals, 1L), distance_fallbacks,
+                contact_fallbacks);
+  }
+};
+
+// Translation only (tilt 0, 1e-8, 1e-4, 1e-2 rad), and with spins about the normal (aligned
+// bodies): a hit at gap / v to 1e-9 relative.
+TEST(SuperquadricContact, FaceToFaceHitAtGapOverClosingSpeed) {
+  Rng r(311);
+  const double exponents[] = {4, 8, 12, 16, 20};
+  const double tilts[] = {0.0, 1e-8, 1e-4, 1e-2};
+  const int reps = scaled_count(12, 0.25, 4);
+  Counts translation, spinning;
+  for (double p : exponents)
+    for (double tilt : tilts)
+      for (int rep = 0; rep < reps; ++rep) {
+        const double X0a = rep % 2 ? 2.0 : 0.5, X0b = (rep / 2) % 2 ? 2.0 : 0.5;
+        Approach s = make_approach(r, p, X0a, X0b, tilt, r.log_uni(1e-3, 1.0));
+        const bool spin = tilt == 0.0 && rep % 3 == 2;
+        if (spin) {  // about n through each centre, up to |w| L = 2 v
+          const double L = std::max(s.a.bounding_radius(), s.b.bounding_radius());
+          s.sa.w = r.uni(-2.0, 2.0) * s.v / L * s.n;
+          s.sb.w = r.uni(-2.0, 2.0) * s.v / L * s.n;
+        }
+        const double t_exact = s.gap / s.v;
+        const ContactResult c = contact_time(ContactInput<Superquadric, Superquadric>{
+            s.a, s.b, s.sa, s.sb, 0.0, 0.0, 2.0 * t_exact + 1.0, 1e-5});
+        Counts& k = spin ? spinning : translation;
+        k.add(c);
+        const std::string what = "p " + std::to_string(p) + " tilt " + std::to_string(tilt) +
+                                 " gap " + std::to_string(s.gap) + (spin ? " spinning" : "");
+        EXPECT_NE(c.status, ContactStatus::failed) << what;
+        ASSERT_EQ(c.status, ContactStatus::hit) << what;
+        const double rel = std::abs(c.time - t_exact) / t_exact;
+        k.max_rel = std::max(k.max_rel, rel);
+        EXPECT_LE(rel, 1e-9) << what << " t " << c.time << " exact " << t_exact;
+        EXPECT_GT(c.normal.dot(s.n), 1.0 - 1e-6) << what;
+      }
+  translation.print("translation");
+  spinning.print("spin about n");
+  EXPECT_EQ(translation.failed + spinning.failed, 0);
+}
+
+// Small spins about random axes (|w| L up to 0.1..1 of the closing speed): a hit, never
+// failed, at the reference time (1e-9 relative, or 1e-9 absolute below t = 1).
+TEST(SuperquadricContact, FaceToFaceWithSpinsVsReference) {
+  Rng r(312);
+  const double exponents[] = {4, 8, 12, 16, 20};
+  const double tilts[] = {0.0, 1e-8, 1e-4, 1e-2};
+  const int reps = scaled_count(4, 0.25, 1);
+  Counts spins;
+  for (double p : exponents)
+    for (double tilt : tilts)
+      for (int rep = 0; rep < reps; ++rep) {
+        const double X0a = rep % 2 ? 2.0 : 0.5, X0b = (rep / 2) % 2 ? 2.0 : 0.5;
+        Approach s = make_approach(r, p, X0a, X0b, tilt, r.log_uni(1e-3, 1.0));
+        const double L = std::max(s.a.bounding_radius(), s.b.bounding_radius());
+        s.sa.w = r.log_uni(1e-4, 1.0) * s.v / L * r.unit();
+        s.sb.w = r.log_uni(1e-4, 1.0) * s.v / L * r.unit();
+        const double t_max = 2.0 * s.gap / s.v + 1.0;
+        const ContactResult c = contact_time(
+            ContactInput<Superquadric, Superquadric>{s.a, s.b, s.sa, s.sb, 0.0, 0.0, t_max, 1e-5});
+        const ref::RefContact rc = ref::reference_contact_time(s.a, s.sa, s.b, s.sb, t_max, 1e-6);
+        spins.add(c);
+        const std::string what = "p " + std::to_string(p) + " tilt " + std::to_string(tilt) +
+                                 " gap " + std::to_string(s.gap);
+        EXPECT_NE(c.status, ContactStatus::failed) << what;
+        ASSERT_TRUE(rc.hit) << what;  // they approach head on: the spins cannot avoid contact
+        ASSERT_EQ(c.status, ContactStatus::hit) << what << " reference t " << rc.time;
+        const double tol = 1e-9 * std::max(1.0, rc.time);
+        spins.max_rel = std::max(spins.max_rel, std::abs(c.time - rc.time) / rc.time);
+        EXPECT_NEAR(c.time, rc.time, tol) << what;
+        EXPECT_LE(c.time, rc.time + tol) << "later than the reference: " << what;
+      }
+  spins.print("random spins");
+  EXPECT_EQ(spins.failed, 0);
+}
+
+}  // namespace
+}  // namespace hb
