@@ -34,7 +34,8 @@
 // convex and decreasing with slope in [-q_max, -q_min]; started left of the root (psi >= 0, at
 // the closed-form root of the same equation with every q_i = q_max, sq_detail::log_root) Newton
 // increases monotonically to the root (no overshoot, no bracket needed), in ~3 steps; exact at
-// once when all exponents are equal.  h = n.x.  Support Hessian (dx/dn):
+// once when all exponents are equal.  The support point itself uses the same equation in
+// y = 1/lambda with pow instead of exp/log and Halley steps (Superquadric::support_point).  h = n.x.  Support Hessian (dx/dn):
 //     (1/lambda) [ diag(a_i^2 t_i^(2-e_i) / (e_i (e_i-1))) - (r.x)(r.x)^T / W ],
 //     r_i = 1/(e_i-1),  W = sum q_i t_i^e_i,
 // which is infinite at n_i = 0 when e_i > 2 (the support point sweeps across the flat face);
@@ -133,7 +134,7 @@ struct Superquadric {
     Vec3 w;
     double S = 0.0;
     for (int i = 0; i < 3; ++i) {
-      P.d2[i] = std::pow(P.t[i], e[i] - 2.0);  // pow(0, 0) = 1 for e_i = 2
+      P.d2[i] = two_[i] ? 1.0 : std::pow(P.t[i], e[i] - 2.0);  // t^0 = 1 for e_i = 2
       P.d1[i] = P.d2[i] * P.t[i];
       w[i] = P.d1[i] * P.t[i];
       S += w[i];
@@ -315,8 +316,8 @@ struct Superquadric {
   }
   // Support point and the multiplier lambda (0 for d = 0).
   // Support point and the multiplier lambda (0 for d = 0).  Solved for y = 1/lambda:
-  // G(y) = sum_i (c_i y)^(q_i) - 1 is convex and increasing, so Newton started right of the root
-  // (G >= 0) decreases monotonically to it.  Start: the closed-form root of the problem with every
+  // G(y) = sum_i (c_i y)^(q_i) - 1 is convex and increasing; started right of the root (G >= 0),
+  // the iteration below moves down to it.  Start: the closed-form root of the problem with every
   // q_i = q_max (each c_i y <= 1 there, so (c_i y)^(q_i) >= (c_i y)^(q_max) and G >= 0); it is the
   // root when all exponents are equal.  Every c_i y stays in [0, 1] (no overflow); q_i = 2 terms
   // (exponent 2) need no pow.  Same root as the log-space form of the header (sq_detail::log_root,
@@ -342,18 +343,27 @@ struct Superquadric {
       y = std::pow(sum, -1.0 / q_max_) / cmax;
     }
     if (!equal_q_) {
+      // Halley's iteration (cubic; G'' costs no extra pow): ~2.6 steps for (2, 2, p) against
+      // ~4.6 Newton steps.  With y-scaled derivatives g1 = y G', g2 = y^2 G'' (both sums of
+      // q_i w_i, q_i (q_i - 1) w_i, q_i in (1, 2]) the error constant is O(1) in units of y, so a
+      // step below 1e-6 y leaves an error ~1e-18 y: stop without a confirming evaluation.
       for (int it = 0; it < 100; ++it) {
-        double G = -1.0, dG = 0.0;  // G(y) and y G'(y)
+        double G = -1.0, g1 = 0.0, g2 = 0.0;
         for (int i = 0; i < 3; ++i) {
           if (cc[i] == 0.0) continue;
           const double w = term(i, cc[i] * y);
           G += w;
-          dG += q_[i] * w;
+          g1 += q_[i] * w;
+          g2 += q_[i] * (q_[i] - 1.0) * w;
         }
-        const double step = G * y / dG;
-        if (!(step > 0.0)) break;  // at (or, by rounding, past) the root
+        // Halley need not stay right of the root (an overshoot gives a negative step, which
+        // comes back); far from the root (a step over half of y) Newton's step, G y / g1 < y
+        // since g1 >= sum w_i = G + 1, keeps y positive
+        double step = 2.0 * G * g1 / (2.0 * g1 * g1 - G * g2) * y;
+        if (!(std::abs(step) < 0.5 * y)) step = G * y / g1;
+        if (!(std::abs(step) > 0.0)) break;
         y -= step;
-        if (step <= 2e-16 * y) break;
+        if (std::abs(step) <= 1e-6 * y) break;
       }
     }
     lambda = 1.0 / y;
