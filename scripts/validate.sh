@@ -18,7 +18,8 @@
 #   `scripts/validate.sh 1000000` (a number first) is the old form: the ellipsoids group.
 # Environment: HB (binary, default build/apps/hardbody/hardbody), WORK (run directories, default
 #   /tmp/hardbody-validate; GSD/log outputs stay there), SQ_P ("2 4 8 12 16"), SQ_X0 ("2 0.5"),
-#   SQ_METHODS ("nnl cells"), E045 ("X0:N:a,b,c ..."), NICE (default 10), DEADLINE (epoch
+#   SQ_METHODS ("nnl cells"), SQ_SNAP (superquadrics group: time between the snapshots that
+#   get the overlap check, default 2.0; each check costs ~1 s of CPU at N = 512), E045 ("X0:N:a,b,c ..."), NICE (default 10), DEADLINE (epoch
 #   seconds: no run starts after it). Runs go one at a time. A failed run (exit 3)
 #   does not stop the group: its command and the last lines of stderr (the reproducer) go to
 #   docs/validation/failures.md.
@@ -135,7 +136,7 @@ case "$group" in
       for m in ${SQ_METHODS:-nnl cells}; do
         for p in ${SQ_P:-2 4 8 12 16}; do
           name=sq_X0_${x0}_p${p}_${m}
-          superquadric_config "$name" "$x0" "$p" "$m" 2.0 && run "$name"
+          superquadric_config "$name" "$x0" "$p" "$m" "${SQ_SNAP:-2.0}" && run "$name"
         done
       done
     done ;;
