@@ -3,7 +3,9 @@
 
 Called by scripts/performance.sh. Every measurement is one run of bench_rigid or bench_ratio
 (one process at a time, under nice); their JSON lines go to OUT/raw.jsonl with the study they
-belong to, and OUT/meta.json records the machine, its load, the source and the CPU time spent.
+belong to, the source they were measured with ("source": the commit, with "-dirty" for a working
+tree with uncommitted changes in src/ or bench/) and the date of the run ("date"), and
+OUT/meta.json records the machine, its load, the source and the CPU time spent.
 scripts/performance_plot.py then writes the CSV tables, the plots and OUT.md.
 
 Studies (section numbers of docs/performance.md):
@@ -11,8 +13,19 @@ Studies (section numbers of docs/performance.md):
   b  tau_c(cells) / tau_c(NNL) vs X0 at phi = 0.3, 0.4, 0.5          (paper Fig. CollTimeX0)
   c  tau_c vs eps_d                                                   (paper Fig. epsd)
   d  tau_c vs the NNL shell at the paper's state points               (paper Fig. delta)
-  e  the issue-4 targets
-  f  superquadrics: tau_c vs p, N = 512, phi = 0.256                  (paper Fig. SQsims)
+  e  the issue-4 targets (studies e1, e2, e3, e4)
+  f  superquadrics: tau_c vs p, N = 512, phi = 0.256                  (paper Fig. SQsims; studies f,
+     f_long, f_ratio)
+  profile  perf call-graph profiles of three points (OUT/profile.json)
+
+Partial re-run (--only STUDIES, comma-separated study-name prefixes, e.g. "f" for f, f_long and
+f_ratio, or "f,e3"): runs only the plan entries whose study starts with one of the prefixes, and
+the perf profile only if the list holds the word "profile". It then merges: the rows of
+OUT/raw.jsonl whose study matches a prefix are dropped, the new rows appended, and raw.jsonl
+rewritten atomically; meta.json keeps the original run's fields and gains an entry in its list
+"updates" (studies, date, source, CPU and wall time, uptime before and after). OUT/raw.jsonl and
+OUT/meta.json of an earlier run of the same mode (full or quick) must exist (exit status 2
+otherwise). --dry-run prints the benchmark commands that would run, and runs nothing.
 """
 import argparse
 import json
@@ -67,15 +80,44 @@ def sq_b(x0):
     return 0.8 / min(x0, 1.0)
 
 
+def matches(study, prefixes):
+    """Whether a study name starts with one of the prefixes of --only."""
+    return any(study.startswith(p) for p in prefixes)
+
+
+def merge_rows(old_rows, new_rows, prefixes):
+    """The rows of a partial re-run merged into an earlier run's: every old row whose study starts
+    with one of the prefixes is dropped and the new rows (all of re-run studies) are appended in
+    their order. The other rows keep their order."""
+    stray = sorted({r.get("study", "?") for r in new_rows if not matches(r.get("study", ""), prefixes)})
+    if stray:
+        raise ValueError(f"new rows of studies outside --only: {', '.join(stray)}")
+    return [r for r in old_rows if not matches(r.get("study", ""), prefixes)] + list(new_rows)
+
+
 class Runner:
-    def __init__(self, build, out):
+    """Runs one benchmark per call and records its rows. only: study prefixes to run (None: all);
+    stamp: fields added to every row (source, date); dry_run: print the commands, run nothing.
+    The rows also go, as they come, to OUT/raw.jsonl.tmp (OUT/raw.jsonl.new.tmp for --only)."""
+
+    def __init__(self, build, out, stamp=None, only=None, dry_run=False):
         self.build = build
-        self.raw = open(os.path.join(out, "raw.jsonl.tmp"), "w")
+        self.stamp = stamp or {}
+        self.only = only
+        self.dry_run = dry_run
+        self.rows = []
+        self.raw_path = os.path.join(out, "raw.jsonl.tmp" if only is None else "raw.jsonl.new.tmp")
+        self.raw = None if dry_run else open(self.raw_path, "w")
         self.cpu = 0.0
 
     def __call__(self, bench, study, **kw):
+        if self.only is not None and not matches(study, self.only):
+            return []
         exe = os.path.join(self.build, "bench", bench)
         cmd = ["nice", "-n", "10", exe] + [f"{k}={v}" for k, v in kw.items()]
+        if self.dry_run:
+            print(f"[{study}] {' '.join([bench] + cmd[4:])}")
+            return []
         t0 = os.times()
         p = subprocess.run(cmd, capture_output=True, text=True)
         t1 = os.times()
@@ -87,6 +129,8 @@ class Runner:
             r["study"] = study
             r["command"] = " ".join([bench] + cmd[4:])
             r["load1"] = os.getloadavg()[0]  # machine load when the run ended
+            r.update(self.stamp)
+            self.rows.append(r)
             self.raw.write(json.dumps(r) + "\n")
             self.raw.flush()
             tau = r.get("tau_c_us", r.get("ratio"))
@@ -127,7 +171,7 @@ def plan(run, c):
     for x0 in sorted(c["e2_x0"], reverse=True):
         rows = run("bench_rigid", "e2", **ELL, N=n_common or 256, phi=0.4, X0=x0, auto_n=1,
                    warmup=5000, warmup_per_particle=c["e2_warm_pp"], collisions=c["e2_coll"])
-        n_common = n_common or rows[0]["N"]
+        n_common = n_common or (rows[0]["N"] if rows else None)
     # (e3) ellipsoids (X0 = 2) against hard spheres, one process
     run("bench_ratio", "e3", pair="spheres", N=256, phi=0.5, X0=2, b=0.5, eps_d="1e-5", shell=0.15,
         collisions=c["e3_coll"], warmup=c["e3_warm"], rounds=10)
@@ -166,13 +210,17 @@ PROFILE_FUNCTIONS = [
 
 
 def profile(run, c, out):
-    """perf call-graph profiles of a few points: inclusive share of the samples per function."""
+    """perf call-graph profiles of a few points: inclusive share of the samples per function.
+    Writes OUT/profile.json (atomically) and returns True, or returns False (no perf, perf failed)."""
     import re
     import shutil
     import tempfile
+    if run.dry_run:
+        print("[profile] 3 perf record runs of bench_rigid -> profile.json")
+        return False
     if not shutil.which("perf"):
         print("performance: perf not found, no profile", file=sys.stderr)
-        return
+        return False
     points = [
         ("ellipsoid X0 = 2, phi = 0.5, N = 256, NNL",
          dict(ELL, N=256, phi=0.5, X0=2, warmup=c["e1_warm"], collisions=2 * c["e1_coll"], split=0)),
@@ -194,7 +242,7 @@ def profile(run, c, out):
             run.cpu += (t1.children_user - t0.children_user) + (t1.children_system - t0.children_system)
             if p.returncode != 0:
                 print(f"performance: perf failed ({p.stderr.strip()[:200]}), no profile", file=sys.stderr)
-                return
+                return False
             rep = subprocess.run(["perf", "report", "-i", data, "--children", "--sort", "symbol", "--stdio",
                                   "-q", "-g", "none"], capture_output=True, text=True).stdout
             syms = []
@@ -209,8 +257,15 @@ def profile(run, c, out):
             for incl, own, sym in sorted(syms, key=lambda s: -s[1])[:12]:
                 rows.append(dict(point=label, kind="self", function=sym[:120], percent=own))
             print(f"[profile] {label}", file=sys.stderr)
-    with open(os.path.join(out, "profile.json"), "w") as f:
-        json.dump(rows, f, indent=0)
+    write_atomic(os.path.join(out, "profile.json"), lambda f: json.dump(rows, f, indent=0))
+    return True
+
+
+def write_atomic(path, write):
+    """write(f) into path.tmp, then rename it over path."""
+    with open(path + ".tmp", "w") as f:
+        write(f)
+    os.replace(path + ".tmp", path)
 
 
 def sh(cmd):
@@ -228,7 +283,48 @@ def source_of(build):
         info["commit"] = sh(f"git -C '{src}' rev-parse HEAD")
         dirty = sh(f"git -C '{src}' status --porcelain -- src bench")
         info["source_note"] = "working tree" + (" with uncommitted changes in src/ or bench/" if dirty else "")
+        info["dirty"] = bool(dirty)
     return info
+
+
+def source_label(info):
+    """The "source" field of the rows: the commit, "-dirty" appended for uncommitted changes."""
+    return (info.get("commit") or "unknown") + ("-dirty" if info.get("dirty") else "")
+
+
+def plan_studies(c):
+    """The study names of the plan, in plan order (the plan run with a recorder, nothing measured)."""
+    names = []
+
+    def record(bench, study, **kw):
+        if study not in names:
+            names.append(study)
+        return []
+    plan(record, c)
+    return names
+
+
+def parse_only(text, studies):
+    """--only STUDIES: (the study prefixes, whether to profile). ValueError for a prefix that
+    matches no study of the plan, or an empty list."""
+    items = [x.strip() for x in text.split(",") if x.strip()]
+    prefixes = [x for x in items if x != "profile"]
+    unknown = [x for x in prefixes if not any(s.startswith(x) for s in studies)]
+    if unknown:
+        raise ValueError(f"no study starts with {', '.join(unknown)} (studies: {', '.join(studies)}, profile)")
+    if not items:
+        raise ValueError("empty study list")
+    return prefixes, "profile" in items
+
+
+def read_rows(path):
+    with open(path) as f:
+        return [json.loads(line) for line in f if line.strip()]
+
+
+def fail(msg, status=2):
+    print(f"performance: {msg}", file=sys.stderr)
+    sys.exit(status)
 
 
 def main():
@@ -236,25 +332,69 @@ def main():
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--out", required=True)
+    ap.add_argument("--only", metavar="STUDIES",
+                    help="comma-separated study prefixes (and/or 'profile') to re-run and merge into OUT")
+    ap.add_argument("--dry-run", action="store_true", help="print the benchmark commands, run nothing")
     a = ap.parse_args()
+    c = QUICK if a.quick else FULL
+    mode = "quick" if a.quick else "full"
+    studies = plan_studies(c)
+    prefixes, with_profile = None, True
+    if a.only is not None:
+        try:
+            prefixes, with_profile = parse_only(a.only, studies)
+        except ValueError as e:
+            fail(f"--only {a.only}: {e}")
+        raw_path, meta_path = os.path.join(a.out, "raw.jsonl"), os.path.join(a.out, "meta.json")
+        for path in (raw_path, meta_path):
+            if not os.path.exists(path):
+                fail(f"--only merges into an earlier run, but {path} does not exist: run the whole study first")
+        old_rows = read_rows(raw_path)
+        with open(meta_path) as f:
+            old_meta = json.load(f)
+        if old_meta.get("mode") != mode:
+            fail(f"--only: {a.out} holds a {old_meta.get('mode')} run, this is a {mode} run; not merging "
+                 f"({'drop --quick' if a.quick else 'add --quick'} or choose another --out)")
+    rerun = [s for s in studies if prefixes is None or matches(s, prefixes)]
+    if a.dry_run:
+        print(f"performance: would run {', '.join(rerun) or 'no study'}" +
+              (" and the profile" if with_profile else "") + f" ({mode} mode)", file=sys.stderr)
+        run = Runner(a.build, a.out, only=prefixes, dry_run=True)
+        plan(run, c)
+        if with_profile:
+            profile(run, c, a.out)
+        return
     os.makedirs(a.out, exist_ok=True)
-    meta = {
-        "mode": "quick" if a.quick else "full",
-        "date": time.strftime("%Y-%m-%d %H:%M:%S %Z"),
-        "cpu_model": sh("lscpu | sed -n 's/^Model name: *//p'"),
-        "cores": os.cpu_count(),
+    src = source_of(a.build)
+    date = time.strftime("%Y-%m-%d %H:%M:%S %Z")
+    info = {
+        "date": date,
         "uptime_before": sh("uptime"),
-        **source_of(a.build),
+        **src,
+        "source_label": source_label(src),
     }
-    run = Runner(a.build, a.out)
+    run = Runner(a.build, a.out, stamp=dict(source=info["source_label"], date=date), only=prefixes)
     t0 = time.time()
-    plan(run, QUICK if a.quick else FULL)
-    profile(run, QUICK if a.quick else FULL, a.out)
+    plan(run, c)
+    profiled = profile(run, c, a.out) if with_profile else False
     run.raw.close()
-    os.replace(os.path.join(a.out, "raw.jsonl.tmp"), os.path.join(a.out, "raw.jsonl"))
-    meta.update(uptime_after=sh("uptime"), cpu_seconds=round(run.cpu, 1), wall_seconds=round(time.time() - t0, 1))
-    with open(os.path.join(a.out, "meta.json"), "w") as f:
-        json.dump(meta, f, indent=1)
+    info.update(uptime_after=sh("uptime"), cpu_seconds=round(run.cpu, 1), wall_seconds=round(time.time() - t0, 1))
+    if prefixes is None:
+        os.replace(run.raw_path, os.path.join(a.out, "raw.jsonl"))
+        meta = {"mode": mode, "date": date, "cpu_model": sh("lscpu | sed -n 's/^Model name: *//p'"),
+                "cores": os.cpu_count(), **info}
+    else:
+        merged = merge_rows(old_rows, run.rows, prefixes)
+        write_atomic(os.path.join(a.out, "raw.jsonl"), lambda f: f.writelines(json.dumps(r) + "\n" for r in merged))
+        os.remove(run.raw_path)  # the new rows alone, kept until the merge was written
+        meta = old_meta
+        meta.setdefault("updates", []).append({
+            "studies": rerun + (["profile"] if profiled else []), "only": a.only, "mode": mode,
+            "cpu_model": sh("lscpu | sed -n 's/^Model name: *//p'"), "cores": os.cpu_count(), **info})
+        print(f"performance: merged {len(run.rows)} new rows of {', '.join(rerun) or 'no study'} into "
+              f"{a.out}/raw.jsonl (dropped {len(old_rows) + len(run.rows) - len(merged)} old rows)" +
+              ("" if profiled or not with_profile else "; the profile was not redone"), file=sys.stderr)
+    write_atomic(os.path.join(a.out, "meta.json"), lambda f: json.dump(meta, f, indent=1))
     print(f"performance: {run.cpu:.0f} s CPU, {time.time() - t0:.0f} s wall", file=sys.stderr)
 
 

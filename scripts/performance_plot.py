@@ -5,6 +5,11 @@ Usage: performance_plot.py OUT_DIR REPORT.md
 Reads OUT_DIR/raw.jsonl and OUT_DIR/meta.json (written by scripts/performance.py); writes
 OUT_DIR/*.csv, OUT_DIR/*.png and REPORT.md, which sets each measured figure next to what the
 paper (C. De Michele, J. Comput. Phys. 229, 3276 (2010)) says about it.
+
+Studies re-measured by a partial re-run (scripts/performance.sh --only) are listed in the header
+(meta.json "updates"), and each section, target and table row whose rows come from such a re-run
+says with which source commit and on which date they were measured (the rows' "source" and
+"date" fields).
 """
 import csv
 import json
@@ -24,6 +29,11 @@ X0_SPREAD_TARGET = 2.0
 SPHERE_RATIO_TARGET = 5.0
 N_SPREAD_TARGET = 1.5
 SQ_RATIO_TARGET = 2.0
+SQ_P_TARGET = 16  # every p = 2 ... 16 runs with NNL without a failure
+# The paper's superquadric limits (section 5): p up to 8 with LLs, up to 4 with NNLs; at p = 2 its
+# superquadric code was 5-6x slower than its ellipsoid code.
+PAPER_SQ_P_LL, PAPER_SQ_P_NNL = 8, 4
+PAPER_SQ_RATIO = (5.0, 6.0)
 
 COLUMNS = ["study", "shape", "N", "N_requested", "phi", "X0", "p", "method", "shell", "eps_d", "seed",
            "status", "tau_c_us", "collisions", "cpu_seconds", "predictions_per_collision",
@@ -32,8 +42,12 @@ COLUMNS = ["study", "shape", "N", "N_requested", "phi", "X0", "p", "method", "sh
            "share_neighbour_events", "share_stale", "fallbacks_total", "overlaps", "S2", "load1", "reason"]
 
 
-def flat(r):
-    d = {k: r.get(k, "") for k in COLUMNS}
+# Provenance columns, written only into the CSV files whose rows carry them.
+SOURCE_COLUMNS = ["source", "date"]
+
+
+def flat(r, columns=COLUMNS):
+    d = {k: r.get(k, "") for k in columns}
     share = r.get("time_share", {})
     d["share_collisions"] = share.get("collisions", "")
     d["share_neighbour_events"] = share.get("neighbour_events", "")
@@ -47,10 +61,11 @@ def flat(r):
 def write_csv(path, rows, columns=None):
     with open(path, "w", newline="") as f:
         if columns is None:
-            w = csv.DictWriter(f, fieldnames=COLUMNS)
+            columns = COLUMNS + [k for k in SOURCE_COLUMNS if any(k in r for r in rows)]
+            w = csv.DictWriter(f, fieldnames=columns)
             w.writeheader()
             for r in rows:
-                w.writerow(flat(r))
+                w.writerow(flat(r, columns))
         else:
             w = csv.writer(f)
             w.writerow(columns)
@@ -87,6 +102,20 @@ def log_ticks(ax, ticks):
     ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
 
 
+def short(label):
+    """A source label (commit, optionally '-dirty') with the commit cut to 7 characters."""
+    commit, dash, rest = label.partition("-")
+    return (commit[:7] if len(commit) == 40 else commit) + dash + rest
+
+
+def source_label(info):
+    """The source label of a run or re-run in meta.json (as scripts/performance.py stamps rows)."""
+    if info.get("source_label"):
+        return info["source_label"]
+    dirty = info.get("dirty", "uncommitted" in info.get("source_note", ""))
+    return (info.get("commit") or "unknown") + ("-dirty" if dirty else "")
+
+
 def verdict(ok):
     return "**PASS**" if ok else "**NOT MET**"
 
@@ -105,6 +134,47 @@ class Report:
         self.rel = os.path.relpath(out, os.path.dirname(os.path.abspath(md_path)) or ".")
         self.lines = []
         self.targets = []  # (name, paper, measured, threshold, verdict bool, note)
+        self.main_source = source_label(meta)
+        self.main_key = (self.main_source, meta.get("date"))
+
+    def origin(self, r):
+        """(source, date) of a row measured by a partial re-run; None for the original run's rows."""
+        if "source" not in r:
+            return None
+        key = (r["source"], r.get("date"))
+        return None if key == self.main_key else key
+
+    def measured_by(self, rows):
+        """'measured with commit `X` on D' for the rows of a list that come from partial re-runs
+        ('' if none do), naming the studies when the list mixes runs."""
+        groups, plain = {}, []
+        for r in rows:
+            k = self.origin(r)
+            if k is None:
+                plain.append(r.get("study", "?"))
+            elif r.get("study", "?") not in groups.setdefault(k, []):
+                groups[k].append(r.get("study", "?"))
+        if not groups:
+            return ""
+        mixed = len(groups) > 1 or plain
+        parts = [(f"{', '.join(ss)} " if mixed else "") + f"measured with commit `{short(src)}` on {date}"
+                 for (src, date), ss in groups.items()]
+        if plain:
+            parts.append(f"{', '.join(dict.fromkeys(plain))} with `{short(self.main_source)}` on {self.meta['date']}")
+        return "; ".join(parts)
+
+    def source_note(self, studies):
+        """The note under a section heading when rows of its studies come from a partial re-run."""
+        rows = [r for r in self.rows if r["study"] in studies]
+        keys = {self.origin(r) for r in rows}
+        if keys <= {None}:
+            return []
+        by = self.measured_by(rows)
+        lead = ("This section was re-measured by a partial re-run (`scripts/performance.sh --only`), "
+                if len(keys) == 1 else
+                "This section was partly re-measured by partial re-runs (`scripts/performance.sh --only`): ")
+        return [f"*{lead}{by}. The rest of the report comes from commit `{short(self.main_source)}` on "
+                f"{self.meta['date']} unless it says otherwise (see the header).*", ""]
 
     def study(self, s, **match):
         return [r for r in self.rows if r["study"] == s and all(r.get(k) == v for k, v in match.items())]
@@ -158,6 +228,7 @@ def header(rep):
           "and frequency; each row of the CSV files carries the 1-minute load when it ended (`load1`).",
           f"* Code: commit `{m.get('commit', '?')}` ({m.get('source_note', '')}), Release build "
           f"(`-O3 -march=x86-64-v2`). Whole study: {m['cpu_seconds']:.0f} s CPU, {m['wall_seconds']:.0f} s wall.",
+          *updates_lines(rep),
           "* Paper: C. De Michele, J. Comput. Phys. 229, 3276 (2010), measured on an Intel Xeon 3.06 GHz "
           "(Prestonia, 512 KB L2, 533 MHz FSB, 2002). Its figures are missing from the source we have "
           "(empty `\\includegraphics`), so only what its text and captions state is quoted below.",
@@ -185,6 +256,41 @@ def header(rep):
           "and the wall-clock share spent in neighbour events.", "")
 
 
+def updates_lines(rep):
+    """The header's list of partial re-runs (meta.json "updates"), if any."""
+    ups = rep.meta.get("updates") or []
+    if not ups:
+        return []
+    m = rep.meta
+    last_profile = max([i for i, u in enumerate(ups) if "profile" in u.get("studies", [])], default=None)
+    lines = ["* Partial re-runs (`scripts/performance.sh --only`), after the run above. Their rows replaced that "
+             "run's rows of the studies they name, so the sections built on those studies (each says so) can come "
+             "from other code than the rest:"]
+    for i, u in enumerate(ups):
+        key = (source_label(u), u.get("date"))
+        studies = u.get("studies", [])
+        kept = list(dict.fromkeys(r["study"] for r in rep.rows if rep.origin(r) == key))
+        if last_profile == i:
+            kept.append("profile")
+        gone = [x for x in studies if x not in kept]
+        state = ("" if not gone else "; all re-measured again later" if not kept else
+                 f"; {', '.join(gone)} re-measured again later")
+        where = (f" on {u['cpu_model']}, {u.get('cores', '?')} cores"
+                 if u.get("cpu_model") and (u["cpu_model"], u.get("cores")) != (m["cpu_model"], m["cores"]) else "")
+        lines.append(f"  * {u.get('date', '?')}: {', '.join(studies) or 'no study'} (`--only {u.get('only', '')}`"
+                     f"{state}), measured with commit `{u.get('commit', '?')}` ({u.get('source_note', '')}){where}; "
+                     f"{u.get('cpu_seconds', 0):.0f} s CPU, {u.get('wall_seconds', 0):.0f} s wall; `uptime` before: "
+                     f"`{u.get('uptime_before', '?')}`; after: `{u.get('uptime_after', '?')}`.")
+    return lines
+
+
+def profile_origin(rep):
+    """(source label, date) of the run that wrote profile.json: the latest re-run that redid it, or the
+    original run."""
+    ups = [u for u in rep.meta.get("updates") or [] if "profile" in u.get("studies", [])]
+    return (source_label(ups[-1]), ups[-1].get("date")) if ups else (rep.main_source, rep.meta["date"])
+
+
 # ---------------------------------------------------------------------------------------------
 def study_a(rep):
     rows = begin(rep, "a", "a_tau_vs_phi.csv")
@@ -208,7 +314,7 @@ def study_a(rep):
     ax[0].legend(fontsize=8)
     rep.save(fig, "a_tau_vs_phi.png")
 
-    rep.w("## (a) tau_c vs phi, cells and NNL (paper Fig. CollTimePhi)", "",
+    rep.w("## (a) tau_c vs phi, cells and NNL (paper Fig. CollTimePhi)", "", *rep.source_note(["a"]),
           "**Paper** (section 4.2, X0 = 0.5 and 2, N = 256, eps_d = 1e-5, Delta_NNL = 0.15): with LLs only, "
           "\"tau_c increases going from lower to higher densities\", roughly linearly in phi. With NNLs, two regimes: "
           "below phi ~ 0.5 tau_c is dominated by the NNL updates and goes as 1/phi, at high phi it grows like phi. "
@@ -284,7 +390,7 @@ def study_b(rep):
     ax[1].legend(fontsize=8)
     rep.save(fig, "b_tau_vs_x0.png")
 
-    rep.w("## (b) cells / NNL vs X0 (paper Fig. CollTimeX0)", "",
+    rep.w("## (b) cells / NNL vs X0 (paper Fig. CollTimeX0)", "", *rep.source_note(["b"]),
           "**Paper** (section 4.3, phi = 0.3, 0.4, 0.5): with LLs the number of bodies in a cell grows \"as X0^2 "
           "(1/X0) for the prolate (oblate) case, and in turns tau_c increases as X0^2 (1/X0)\"; \"using NNLs tau_c is "
           "quite X0-independent\"; \"at very high elongation (X0 >~ 5), the NR method requires more steps to "
@@ -380,7 +486,7 @@ def study_c(rep):
         ax[0][k].legend(fontsize=8)
     rep.save(fig, "c_tau_vs_epsd.png")
 
-    rep.w("## (c) tau_c vs eps_d (paper Fig. epsd)", "",
+    rep.w("## (c) tau_c vs eps_d (paper Fig. epsd)", "", *rep.source_note(["c"]),
           "**Paper** (section 4.4, NNL, X0 = 0.5 and 2, phi = 0.30-0.55): \"too large a value for this parameter may "
           "result in a failure of EDMD due to overlaps of HEs. Hence, the best choice for eps_d is the largest value "
           "not generating HEs overlaps.\" \"Fig. epsd shows that tau_c monotonically decreases as eps_d is decreased, "
@@ -440,7 +546,7 @@ def study_d(rep):
         ax[0][k].legend(fontsize=8)
     rep.save(fig, "d_tau_vs_shell.png")
 
-    rep.w("## (d) tau_c vs the NNL shell Delta_NNL (paper Figs. delta and optdelta)", "",
+    rep.w("## (d) tau_c vs the NNL shell Delta_NNL (paper Figs. delta and optdelta)", "", *rep.source_note(["d"]),
           "**Paper** (section 4.5, X0 = 0.5 and 2 at phi = 0.45 and 0.57): \"computational times vary "
           "non-monotonically\"; tau_c diverges for Delta_NNL -> 0 (rebuilds) and for Delta_NNL -> infinity (neighbours), "
           "\"tau_c(Delta_NNL) exhibits a clear minimum\". \"Delta*_NNL depends much more on the volume fraction phi "
@@ -494,7 +600,7 @@ def study_e(rep):
                             "~2.5 ms (2002 CPU)",
                             (f"{med:.1f} us (median of {len(taus)} seeds: {', '.join(f'{t:.1f}' for t in taus)})"
                              if len(taus) > 1 else f"{med:.1f} us (one seed)"),
-                            f"<= {TAU_TARGET_US:g} us", med <= TAU_TARGET_US, ""))
+                            f"<= {TAU_TARGET_US:g} us", med <= TAU_TARGET_US, rep.measured_by(e1)))
     # e2
     e2 = rep.ok("e2")
     if e2:
@@ -503,7 +609,8 @@ def study_e(rep):
         rep.targets.append(("tau_c(NNL) max/min over X0 = 1, 2, 5, 10 at phi = 0.4",
                             "\"quite X0-independent\" up to X0 = 10",
                             f"{spread:.2f} (" + ", ".join(f"X0={k:g}: {v:.0f} us" for k, v in sorted(t.items())) +
-                            f"; N = {e2[0]['N']})", f"<= {X0_SPREAD_TARGET:g}", spread <= X0_SPREAD_TARGET, ""))
+                            f"; N = {e2[0]['N']})", f"<= {X0_SPREAD_TARGET:g}", spread <= X0_SPREAD_TARGET,
+                            rep.measured_by(e2)))
     # e3
     e3 = rep.ok("e3") or rep.study("e3")
     if e3:
@@ -513,7 +620,7 @@ def study_e(rep):
                             f"{r['ratio']:.1f} (ellipsoids {r['B']['tau_c_us']:.1f} us, spheres "
                             f"{r['A']['tau_c_us']:.2f} us; 10 alternating rounds, ratio {r['ratio_min']:.1f}-"
                             f"{r['ratio_max']:.1f})", f"<= {SPHERE_RATIO_TARGET:g}",
-                            r["ratio"] <= SPHERE_RATIO_TARGET, ""))
+                            r["ratio"] <= SPHERE_RATIO_TARGET, rep.measured_by([r])))
     # e4
     e4 = sorted(rep.ok("e4"), key=lambda r: r["N"])
     write_csv(os.path.join(out, "e_targets_runs.csv"), rep.study("e1") + rep.study("e2") + rep.study("e4"))
@@ -524,7 +631,7 @@ def study_e(rep):
                             "(X0 = 2, phi = 0.5, NNL), max/min",
                             "not studied (N = 256 only)",
                             f"{spread:.2f} (" + ", ".join(f"N={r['N']}: {r['tau_c_us']:.1f} us" for r in e4) + ")",
-                            f"<= {N_SPREAD_TARGET:g}", spread <= N_SPREAD_TARGET, ""))
+                            f"<= {N_SPREAD_TARGET:g}", spread <= N_SPREAD_TARGET, rep.measured_by(e4)))
         fig, ax = plt.subplots(figsize=(5.5, 4))
         ax.plot([r["N"] for r in e4], t, marker="o", label="tau_c (X0 = 2, phi = 0.5, NNL)")
         ax.axhspan(min(t), min(t) * N_SPREAD_TARGET, color="tab:green", alpha=0.15, label="1.5x band (target)")
@@ -553,7 +660,7 @@ def study_f(rep):
         ax[k].legend(fontsize=8)
     rep.save(fig, "f_superquadrics.png")
 
-    rep.w("## (f) Superquadrics: tau_c vs p (paper Fig. SQsims)", "",
+    rep.w("## (f) Superquadrics: tau_c vs p (paper Fig. SQsims)", "", *rep.source_note(["f", "f_long", "f_ratio"]),
           "**Paper** (section 5): \"A monodisperse system of N=512 SQs has been simulated with m=n=2 and with two "
           "equal semi-axes, i.e. b=c\" at phi = 0.256, X0 = 0.5 and 2, smallest semi-axis 0.8, I = 1. \"For the LLs "
           "case p ranges from 2 to 8, while enabling NNLs it ranges from 2 to 4 only. In the case of LLs for values of "
@@ -592,10 +699,10 @@ def study_f(rep):
     if ratio:
         r = ratio[0]
         rep.targets.append(("superquadric (2, 2, 2) / ellipsoid cost per collision (N = 512, phi = 0.256, X0 = 2, "
-                            "NNL, one process)", "at least 5-6",
+                            "NNL, one process)", f"at least {PAPER_SQ_RATIO[0]:g}-{PAPER_SQ_RATIO[1]:g}",
                             f"{r['ratio']:.2f} (superquadric {r['B']['tau_c_us']:.0f} us, ellipsoid "
                             f"{r['A']['tau_c_us']:.0f} us; rounds {r['ratio_min']:.2f}-{r['ratio_max']:.2f})",
-                            f"<= {SQ_RATIO_TARGET:g}", r["ratio"] <= SQ_RATIO_TARGET, ""))
+                            f"<= {SQ_RATIO_TARGET:g}", r["ratio"] <= SQ_RATIO_TARGET, rep.measured_by([r])))
     everything = rows + longr
     failed = [r for r in everything if r.get("status") != "ok" or r.get("overlaps", 0)]
     nnl = [r for r in everything if r["method"] == "nnl"]
@@ -603,14 +710,16 @@ def study_f(rep):
     pmax = max(r["p"] for r in nnl)
     fb = sum(r.get("fallbacks_total", 0) or 0 for r in nnl)
     coll = sum(r.get("collisions_total", 0) or 0 for r in nnl)
-    rep.targets.append((f"every p = 2 ... {pmax:g} runs with NNL without a failure",
-                        "NNL only up to p = 4, LL up to p = 8",
+    missing = [p for p in range(2, SQ_P_TARGET + 1) if p > pmax]
+    rep.targets.append((f"every p = 2 ... {SQ_P_TARGET:g} runs with NNL without a failure",
+                        f"NNL only up to p = {PAPER_SQ_P_NNL}, LL up to p = {PAPER_SQ_P_LL}",
                         f"{len(nnl)} NNL runs, {coll:.0f} collisions, {fb:.0f} solver fallbacks (recovered); " +
                         (f"{len(nnl_failed)} failed: " + "; ".join(
                             f"X0 = {r['X0']:g}, p = {r['p']:g}, seed {r['seed']} after {r.get('collisions_total', 0):.0f} "
                             f"collisions ({(r.get('reason') or '').split('; reproducer')[0]})" for r in nnl_failed)
-                         if nnl_failed else "no failure, no overlap"),
-                        "0 failures", not nnl_failed, ""))
+                         if nnl_failed else "no failure, no overlap") +
+                        (f"; measured only up to p = {pmax:g}" if missing else ""),
+                        "0 failures", not nnl_failed and not missing, rep.measured_by(everything)))
     okn = rep.ok("f", method="nnl")
     okc = rep.ok("f", method="cells")
     text = ["**Here.**"]
@@ -619,19 +728,106 @@ def study_f(rep):
         for r in okn:
             by_p.setdefault(r["p"], []).append(r["tau_c_us"])
         p_lo, p_hi = min(by_p), max(by_p)
-        text.append(f"tau_c grows with p, as in the paper: NNL {span(by_p[p_lo])} at p = {p_lo:g}, "
-                    f"{span(by_p[p_hi])} at p = {p_hi:g}. Most of the step comes between p = 2 and 3. With equal "
-                    "exponents the 1-D equations in logarithms behind the support point, the surface ray and the "
-                    "bounding radius (`sq_detail::log_root`) are linear and Newton solves them in one step. With "
-                    "(2, 2, p > 2) they take several (see the profile). Beyond that the NR iterations per distance "
-                    "evaluation creep up with p, while the predictions per collision stay the same.")
-        with_fb = sorted(r["p"] for r in everything if (r.get("fallbacks_total") or 0) > 0)
+        if min(by_p[p_hi]) > max(by_p[p_lo]):
+            trend = "tau_c grows with p, as in the paper"
+        elif max(by_p[p_hi]) < min(by_p[p_lo]):
+            trend = "tau_c falls with p, unlike the paper's increase at high p"
+        else:
+            trend = "tau_c hardly changes with p, unlike the paper's increase at high p"
+        text.append(f"{trend}: NNL {span(by_p[p_lo])} at p = {p_lo:g}, {span(by_p[p_hi])} at p = {p_hi:g}.")
+        # where the rise comes from: steps of the mean over X0, at the p where every X0 ran
+        n_x0 = len({r["X0"] for r in okn})
+        mean = {p: sum(t) / len(t) for p, t in by_p.items() if len(t) == n_x0}
+        ps = sorted(mean)
+        if len(ps) >= 3 and mean[ps[-1]] > mean[ps[0]]:
+            total = mean[ps[-1]] - mean[ps[0]]
+            d, pa, pb = max((mean[b] - mean[a], a, b) for a, b in zip(ps, ps[1:]))
+            where = f"({100 * d / total:.0f} % of the rise from p = {ps[0]:g} to {ps[-1]:g}, mean over X0)"
+            if d > 0.5 * total:
+                text.append(f"Most of the rise comes between p = {pa:g} and {pb:g} {where}.")
+                if pa == 2:
+                    prof = os.path.join(rep.out, "profile.json")
+                    log_root = []
+                    if os.path.exists(prof):
+                        log_root = [(r["percent"], r["point"]) for r in json.load(open(prof))
+                                    if r["kind"] == "inclusive" and r["point"].startswith("superquadric")
+                                    and r["function"] == "superquadric 1-D log root" and r["percent"] > 0]
+                    f_origin = rep.origin(okn[0]) or rep.main_key
+                    p_origin = profile_origin(rep)
+                    by = "" if p_origin == f_origin else f", measured with commit `{short(p_origin[0])}`,"
+                    text.append("With equal exponents the 1-D equations in logarithms behind the support point, the "
+                                "surface ray and the bounding radius (`sq_detail::log_root`) are linear and Newton "
+                                "solves them in one step. With (2, 2, p > 2) they take several" +
+                                (f" (in the profile below{by} they take {log_root[0][0]:.0f} % of the time at the point "
+                                 f"\"{log_root[0][1]}\")." if log_root else "."))
+            else:
+                text.append(f"The rise is spread over p: the largest step, p = {pa:g} to {pb:g}, is {where[1:-1]}.")
+        # counters from p = 2 to the highest p that ran, per X0
+        per_x0 = []
+        for x0 in x0s:
+            rs = sorted(rep.ok("f", X0=x0, method="nnl"), key=lambda r: r["p"])
+            if len(rs) >= 2:
+                per_x0.append((x0, rs[0], rs[-1]))
+        if per_x0:
+            nr = [(a["distance_nr_iterations_per_eval"], b["distance_nr_iterations_per_eval"]) for _, a, b in per_x0]
+            pred = [b["predictions_per_collision"] / a["predictions_per_collision"] - 1 for _, a, b in per_x0]
+            up = all(b > a for a, b in nr)
+            down = all(b < a for a, b in nr)
+            text.append("From the lowest to the highest p that ran with NNL (" +
+                        ", ".join(f"p = {a['p']:g} to {b['p']:g} at X0 = {x0:g}" for x0, a, b in per_x0) +
+                        ") the NR iterations per distance evaluation " +
+                        ("rise" if up else "fall" if down else "change") + " " +
+                        " and ".join(f"from {a:.1f} to {b:.1f} (X0 = {x0:g})" for (a, b), (x0, _, _) in zip(nr, per_x0)) +
+                        (", while the predictions per collision change by only " if max(abs(x) for x in pred) <= 0.1
+                         else ", and the predictions per collision change by ") +
+                        " and ".join(f"{100 * x:+.0f} %" for x in pred) + ".")
+        with_fb = sorted({r["p"] for r in everything if (r.get("fallbacks_total") or 0) > 0})
         if with_fb:
-            text.append(f"Solver fallbacks (counted, recovered) start at p = {with_fb[0]:g} and grow with p.")
+            rate = []
+            for p in sorted({r["p"] for r in everything if r["p"] >= with_fb[0]}):
+                at = [r for r in everything if r["p"] == p]
+                n = sum(r.get("collisions_total") or 0 for r in at)
+                if n:
+                    rate.append((p, 1e3 * sum(r.get("fallbacks_total") or 0 for r in at) / n))
+            growing = len(rate) > 1 and all(b[1] >= a[1] for a, b in zip(rate, rate[1:]))
+            text.append(f"Solver fallbacks (counted, recovered) start at p = {with_fb[0]:g}" +
+                        (" and grow with p" if growing else "") + ": " +
+                        ", ".join(f"{x:.2g}" for _, x in rate) + " per 1000 collisions at p = " +
+                        ", ".join(f"{p:g}" for p, _ in rate) + " (all runs).")
         pairs = [(c["tau_c_us"] / n["tau_c_us"]) for n in okn for c in okc if (c["X0"], c["p"]) == (n["X0"], n["p"])]
         if pairs:
             text.append(f"At phi = 0.256 cells cost {min(pairs):.2f}-{max(pairs):.2f}x NNL: the cells hold few "
                         "bodies at this density.")
+    if ratio:
+        r = ratio[0]
+        lo, hi = PAPER_SQ_RATIO
+        cmp_paper = ("below the paper's" if r["ratio"] < lo else "above the paper's" if r["ratio"] > hi else
+                     "like the paper's")
+        text.append(f"Against the ellipsoid engine in one process (X0 = 2, p = 2, NNL, alternating rounds) the "
+                    f"superquadrics cost {r['ratio']:.2f}x ({r['B']['tau_c_us']:.0f} us against "
+                    f"{r['A']['tau_c_us']:.0f} us; rounds {r['ratio_min']:.2f}-{r['ratio_max']:.2f}), "
+                    f"{cmp_paper} {lo:g}-{hi:g}x; the target, at most {SQ_RATIO_TARGET:g}x, is " +
+                    ("met." if r["ratio"] <= SQ_RATIO_TARGET else "not met."))
+
+    def reach(m):
+        """The highest p up to which every run of method m finished, the p where some failed."""
+        ps = sorted({r["p"] for r in everything if r["method"] == m})
+        bad = sorted({r["p"] for r in failed if r["method"] == m})
+        ok = [p for p in ps if not bad or p < bad[0]]
+        return (max(ok) if ok else None), bad, ps
+
+    limits = []
+    for m, name, paper in (("nnl", "NNL", PAPER_SQ_P_NNL), ("cells", "cells", PAPER_SQ_P_LL)):
+        best, bad, ps = reach(m)
+        if not ps:
+            continue
+        if best is None:
+            limits.append(f"with {name} a run failed already at p = {ps[0]:g} (the paper's limit: p = {paper})")
+            continue
+        rel = "above" if best > paper else "the same as" if best == paper else "below"
+        limits.append(f"with {name} every run up to p = {best:g} finished" +
+                      (" (the highest p measured)" if not bad and best == ps[-1] else "") +
+                      f", {rel} the paper's p = {paper}{' with LL' if m == 'cells' else ''}")
     if failed:
         def why(r):
             return (r.get("reason") or "").split("; reproducer")[0]
@@ -640,7 +836,6 @@ def study_f(rep):
             f"{r.get('collisions_total', 0):.0f} collisions: {why(r)}" for r in failed) + ".")
         at_coll = [r for r in failed if "at the collision" in why(r)]
         in_pred = [r for r in failed if "contact-time solver failed" in why(r)]
-        p_ok = max([r["p"] for r in everything if r["p"] < min(q["p"] for q in failed)], default=None)
         same = [(n, c) for n in failed for c in failed
                 if n["method"] == "nnl" and c["method"] == "cells" and (n["X0"], n["p"], n["seed"]) ==
                 (c["X0"], c["p"], c["seed"]) and n.get("collisions_total") == c.get("collisions_total")]
@@ -653,9 +848,12 @@ def study_f(rep):
         if same:
             text.append("Cells and NNL run from the same start failed at the same collision, so the failure lies in "
                         "the pair solvers, not in the neighbour method.")
-        if p_ok is not None:
-            text.append(f"Every run with p <= {p_ok:g} finished. That moves the paper's limits up (p = 4 with NNL, "
-                        "8 with LL), but p = 16 is not yet robust.")
+        if limits:
+            text.append("; ".join(limits)[0].upper() + "; ".join(limits)[1:] + ".")
+        bad_p = sorted({r["p"] for r in failed})
+        text.append(f"p = {', '.join(f'{p:g}' for p in bad_p)} {'is' if len(bad_p) == 1 else 'are'} not yet robust: " +
+                    ", ".join(f"{sum(1 for r in failed if r['p'] == p)} of {sum(1 for r in everything if r['p'] == p)} "
+                              f"runs at p = {p:g} failed" for p in bad_p) + ".")
         text.append("Each failed pair, at the failure time, in the `hardbody distance` input format (a contact-time "
                     "failure also carries its own `hardbody contact-time` reproducer in the CSV's reason):")
         rep.w(" ".join(text), "")
@@ -667,7 +865,8 @@ def study_f(rep):
                 rep.w(f"* X0 = {r['X0']:g}, p = {r['p']:g}, seed {r['seed']}, {r['method']}: {why(r)}", "",
                       "```json", r["reproducer"], "```", "")
     else:
-        rep.w(" ".join(text + ["No run failed and no overlap was found."]), "")
+        rep.w(" ".join(text + ["No run failed and no overlap was found" +
+                               (": " + "; ".join(limits) if limits else "") + "."]), "")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -694,6 +893,14 @@ def where_time_goes(rep):
         add(f"superquadric X0 = {x0:g}, p = 16", rep.ok("f", X0=x0, p=16.0, method="nnl"))
     rep.table(["point", "tau_c (us)"] + COST_HEADER,
               [[lab, fmt(r["tau_c_us"])] + cost_row(r) for lab, r in picks])
+    redone = {}
+    for lab, r in picks:
+        if rep.origin(r):
+            redone.setdefault(rep.origin(r), []).append(lab.strip())
+    if redone:
+        rep.w("*Re-measured by a partial re-run: " + "; ".join(
+            f"{', '.join(labs)}: commit `{short(src)}` on {date}" for (src, date), labs in redone.items()) +
+            f". The other points: commit `{short(rep.main_source)}`.*", "")
     r0 = dict(picks).get("ellipsoid X0 = 2, phi = 0.5, N = 256")
     if r0:
         text = (f"At the reference point (X0 = 2, phi = 0.5) a collision costs {r0['predictions_per_collision']:.0f} "
@@ -729,9 +936,14 @@ def profile_section(rep):
     write_csv(os.path.join(rep.out, "profile.csv"),
               [[r["point"], r["kind"], r["function"], r["percent"]] for r in prof],
               ["point", "kind", "function", "percent"])
+    src, date = profile_origin(rep)
     rep.w("Profile (`perf record --call-graph dwarf`, 200 Hz, the whole benchmark process including its "
           "warm-up): share of the CPU samples spent inside each function and its callees. Indented rows are "
-          "parts of the row above; a distance solve at a collision counts under the impulse too.", "")
+          "parts of the row above; a distance solve at a collision counts under the impulse too." +
+          (f" Measured with commit `{short(src)}` on {date}" +
+           (" (the original run, not redone by the partial re-runs in the header)."
+            if (src, date) == rep.main_key else " (a partial re-run).")
+           if rep.meta.get("updates") else ""), "")
     body = []
     for f in funcs:
         if all(val.get((p, f), 0.0) == 0.0 for p in points):
@@ -746,31 +958,40 @@ def profile_section(rep):
     if sq:
         br = val.get((sq[0], "superquadric bounding radius"), 0.0)
         sp = val.get((sq[0], "superquadric support point"), 0.0)
-        rep.w(f"For superquadrics {br:.0f} % of the time goes into `Superquadric::bounding_radius()`, a constant "
-              "of the shape that is recomputed (KKT solve plus a ray root, with log/exp) at every call from the "
-              f"contact-time, separating-axis and escape-time code. Another {sp:.0f} % goes into the support point "
-              "(a 1-D root in logarithms per call), used by the separating-axis steps and the analytic body-plane "
-              "distance of the NNL escape time. Caching the bounding radius in the shape would remove the first "
-              "part outright; that is the largest single gain toward the superquadric/ellipsoid target "
-              "(`src/shapes/superquadric.hpp`, not changed here).", "")
+        support = (f"{sp:.0f} % goes into the support point (a 1-D root in logarithms per call), used by the "
+                   "separating-axis steps and the analytic body-plane distance of the NNL escape time.")
+        if br >= 1.0:
+            rep.w(f"For superquadrics {br:.0f} % of the time goes into `Superquadric::bounding_radius()`, a constant "
+                  "of the shape that is recomputed (KKT solve plus a ray root, with log/exp) at every call from the "
+                  f"contact-time, separating-axis and escape-time code. Another {support} Caching the bounding "
+                  "radius in the shape would remove the first part outright; that is the largest single gain toward "
+                  "the superquadric/ellipsoid target (`src/shapes/superquadric.hpp`, not changed here).", "")
+        else:
+            rep.w(f"For superquadrics `Superquadric::bounding_radius()` takes {br:.0f} % of the time in this "
+                  f"profile; {support}", "")
 
 
 def summary(rep):
     rep.w("## Issue-4 targets", "")
+    def measured(m, note):
+        return f"{m}; {note}" if note else m
     rep.table(["target", "paper", "measured here", "threshold", "verdict"],
-              [[n, p, m, th, verdict(ok)] for n, p, m, th, ok, _ in rep.targets])
+              [[n, p, measured(m, note), th, verdict(ok)] for n, p, m, th, ok, note in rep.targets])
     write_csv(os.path.join(rep.out, "e_targets.csv"),
-              [[n, p, m, th, "PASS" if ok else "NOT MET"] for n, p, m, th, ok, _ in rep.targets],
+              [[n, p, measured(m, note), th, "PASS" if ok else "NOT MET"] for n, p, m, th, ok, note in rep.targets],
               ["target", "paper", "measured", "threshold", "verdict"])
     same = ([("a", r) for r in rep.ok("a", X0=2.0, phi=0.5, method="nnl")] +
             [("e1", r) for r in rep.ok("e1")] +
-            [("e3", {"tau_c_us": r["B"]["tau_c_us"]}) for r in rep.study("e3")] +
+            [("e3", dict(r, tau_c_us=r["B"]["tau_c_us"])) for r in rep.study("e3")] +
             [("e4", r) for r in rep.ok("e4") if r["N"] == 256])
     if len(same) > 1:
         t = [r["tau_c_us"] for _, r in same]
+        mixed = len({rep.origin(r) for _, r in same}) > 1
         rep.w("Repeatability: the point X0 = 2, phi = 0.5 (NNL) was measured in several separate runs of this study "
               "(" + ", ".join(f"{k}: {r['tau_c_us']:.1f} us" for k, r in same) + f"), a spread of "
-              f"{100 * (max(t) / min(t) - 1):.0f} % on this shared machine. Read differences below ~15-20 % between single runs as noise.", "")
+              f"{100 * (max(t) / min(t) - 1):.0f} % on this shared machine. Read differences below ~15-20 % between single runs as noise." +
+              (" Some of these runs come from a partial re-run with other code (" + rep.measured_by([r for _, r in same]) +
+               "), so this spread also holds the code change." if mixed else ""), "")
     if rep.ok("e4"):
         rep.figure("e_tau_vs_n.png", "tau_c vs N")
 
@@ -795,7 +1016,10 @@ def main():
     rep.lines += body.lines
     rep.w("## Files", "",
           f"`{out}/raw.jsonl`: every measurement as printed by the benchmarks (with the command line). "
-          f"`{out}/meta.json`: machine, load, source. CSV per study: `a_tau_vs_phi.csv`, `b_tau_vs_x0.csv`, "
+          f"`{out}/meta.json`: machine, load, source" +
+          (", and the partial re-runs under `updates`" if meta.get("updates") else "") +
+          (". Rows carry the source commit (`source`) and the date of their run (`date`)"
+           if any("source" in r for r in rows) else "") + ". CSV per study: `a_tau_vs_phi.csv`, `b_tau_vs_x0.csv`, "
           "`c_tau_vs_epsd.csv`, `d_tau_vs_shell.csv`, `e_targets.csv` (the verdicts), `e_targets_runs.csv`, "
           "`f_superquadrics.csv`. The benchmarks: `bench/bench_rigid.cpp` (one state point, or a scan over "
           "method / shell / eps_d on one trajectory) and `bench/bench_ratio.cpp` (two engines timed in "
