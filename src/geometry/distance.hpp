@@ -92,7 +92,7 @@
 //   4. a long steepest descent (tight angle) from the cold guess, then NR on 8 equations;
 //   5. the 5-equation system from the same guess;
 //   6. the 8-equation system from the centre-line guess without SD;
-//   7. (shapes with a support function, separated bodies) the maximum over directions of the
+//   7. (shapes with a support function) the maximum over directions of the
 //      gap along a direction (support_maximum, below): a different algorithm, robust where the
 //      contact equations are singular along straight walls and flat faces.
 // If all fail the status is `failed` and the distance is the best upper bound found (the
@@ -667,8 +667,10 @@ void support_guess(const Posed<SA>& A, const Posed<SB>& B, Vec3& xa, Vec3& xb) {
 // is accurate to second order in the error of n even where the support point is not (the
 // flat faces of high-exponent superquadrics, where the NR on the contact equations stalls:
 // sliding along straight walls leaves J nearly singular).  Converged when the bounds meet to
-// tol (relative) or the step is below 1e-14 rad (G then exact to rounding).  Only for
-// separated bodies: returns false unless G > 0.
+// tol (relative) or the step is below 1e-14 rad (G then exact to rounding).  For overlapping
+// bodies the maximum is negative: minus the penetration depth (the shortest translation that
+// separates them), also a signed distance that vanishes at contact; this matters at a contact
+// (collisions, just-collided pairs), where G is zero to rounding and may come out -1e-14.
 template <SupportShape SA, SupportShape SB>
 bool support_maximum(const Posed<SA>& A, const Posed<SB>& B, Vec3 n, const DistanceOptions& o,
                      const Scales& sc, int& iters, Point& out, double& G_out, Vec3& n_out) {
@@ -718,8 +720,8 @@ bool support_maximum(const Posed<SA>& A, const Posed<SB>& B, Vec3 n, const Dista
         break;
       }
     }
-    if (!moved || delta.norm() <= 1e-14) {
-      ok = G > 0.0;
+    if (!moved || delta.norm() <= 1e-14) {  // converged: G is the maximum to rounding
+      ok = true;
       break;
     }
   }
@@ -817,7 +819,7 @@ DistanceResult distance(const SA& a, const Pose& pa, const SB& b, const Pose& pb
     cold_guess(A, B, DistanceGuess::center_line, ca, cb);
     run(6, multipliers(A, B, ca, cb), DistanceSystem::eight);
   }
-  // 7. (shapes with a support function, separated bodies) maximum of the gap over directions,
+  // 7. (shapes with a support function) maximum of the gap over directions,
   // from the best direction seen: the SD estimate's joining line
   bool dual = false;
   double G = 0.0;

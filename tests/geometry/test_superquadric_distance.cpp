@@ -486,5 +486,28 @@ TEST(SuperquadricDistance, StraightWallsSideBySide) {
   EXPECT_LE(std::abs(ba.distance - rd.distance), 1e-8 * rd.distance);
 }
 
+
+// A just-collided pair (contact-time failure of a validation run: NNL, X0 = 0.5, p = 12,
+// bodies 507 and 67 at t = 63.289, docs/validation/failures.md): the bodies touch, every NR
+// stage fails on the flat faces, and the gap maximum (stage 7) is -1e-14, zero to rounding.
+// Stage 7 used to accept only positive maxima; a touching pair must give |d| at rounding level.
+TEST(SuperquadricDistance, JustCollidedFlatPairIsTouching) {
+  const Superquadric s{0.8, 1.6, 1.6, 2.0, 2.0, 12.0};
+  const Pose pa{Vec3(3.637648057770667, 11.826317321173217, 21.307758097961653),
+                Quat(-0.6654538443604486, 0.028019301066517854, -0.7437050684021581, -0.05734867937960988).normalized().toRotationMatrix()};
+  const Pose pb{Vec3(3.299030342676802, 14.301695322165555, 22.792031348653875),
+                Quat(-0.13485383628412342, 0.635016533903404, 0.1916619467718254, -0.7360938409390448).normalized().toRotationMatrix()};
+  const DistanceResult ab = distance(s, pa, s, pb), ba = distance(s, pb, s, pa);
+  const ref::RefDistance rd = slow_reference(s, pa, s, pb);
+  std::printf("  just-collided pair: d %.3e (attempt %d), d(B,A) %.3e (attempt %d), reference %.3e\n",
+              ab.distance, ab.attempt, ba.distance, ba.attempt, rd.distance);
+  ASSERT_NE(ab.status, DistanceStatus::failed);
+  ASSERT_NE(ba.status, DistanceStatus::failed);
+  const double floor = 1e-12 * s.bounding_radius();
+  EXPECT_LE(std::abs(ab.distance), floor);
+  EXPECT_LE(std::abs(ba.distance), floor);
+  EXPECT_LE(std::abs(rd.distance), floor);
+}
+
 }  // namespace
 }  // namespace hb
