@@ -746,20 +746,19 @@ def study_f(rep):
             if d > 0.5 * total:
                 text.append(f"Most of the rise comes between p = {pa:g} and {pb:g} {where}.")
                 if pa == 2:
-                    prof = os.path.join(rep.out, "profile.json")
-                    log_root = []
-                    if os.path.exists(prof):
-                        log_root = [(r["percent"], r["point"]) for r in json.load(open(prof))
-                                    if r["kind"] == "inclusive" and r["point"].startswith("superquadric")
-                                    and r["function"] == "superquadric 1-D log root" and r["percent"] > 0]
-                    f_origin = rep.origin(okn[0]) or rep.main_key
-                    p_origin = profile_origin(rep)
-                    by = "" if p_origin == f_origin else f", measured with commit `{short(p_origin[0])}`,"
-                    text.append("With equal exponents the 1-D equations in logarithms behind the support point, the "
-                                "surface ray and the bounding radius (`sq_detail::log_root`) are linear and Newton "
-                                "solves them in one step. With (2, 2, p > 2) they take several" +
-                                (f" (in the profile below{by} they take {log_root[0][0]:.0f} % of the time at the point "
-                                 f"\"{log_root[0][1]}\")." if log_root else "."))
+                    # axis steps per collision at the lowest and next p (both X0 pooled)
+                    steps = {}
+                    for r in okn:
+                        if r["p"] in (pa, pb) and r.get("axis_steps_per_collision") is not None:
+                            steps.setdefault(r["p"], []).append(float(r["axis_steps_per_collision"]))
+                    st = (f" (separating-axis steps per collision {sum(steps[pa]) / len(steps[pa]):.0f} at "
+                          f"p = {pa:g} against {sum(steps[pb]) / len(steps[pb]):.0f} at p = {pb:g}, NNL)"
+                          if pa in steps and pb in steps else "")
+                    text.append("Two things change at p = 2: with all exponents 2 the body has a bounded curvature "
+                                "radius, so the separating-axis advancement takes second-order steps, while any "
+                                "exponent above 2 flattens the surface and leaves only first-order steps" + st +
+                                "; and with equal exponents the support point is in closed form, while (2, 2, p > 2) "
+                                "needs a 1-D root (Halley steps with `pow`) per support point.")
             else:
                 text.append(f"The rise is spread over p: the largest step, p = {pa:g} to {pb:g}, is {where[1:-1]}.")
         # counters from p = 2 to the highest p that ran, per X0
@@ -958,7 +957,7 @@ def profile_section(rep):
     if sq:
         br = val.get((sq[0], "superquadric bounding radius"), 0.0)
         sp = val.get((sq[0], "superquadric support point"), 0.0)
-        support = (f"{sp:.0f} % goes into the support point (a 1-D root in logarithms per call), used by the "
+        support = (f"{sp:.0f} % goes into the support point (a 1-D root per call, Halley steps with `pow`), used by the "
                    "separating-axis steps and the analytic body-plane distance of the NNL escape time.")
         if br >= 1.0:
             rep.w(f"For superquadrics {br:.0f} % of the time goes into `Superquadric::bounding_radius()`, a constant "
