@@ -18,6 +18,7 @@
 #   `scripts/validate.sh 1000000` (a number first) is the old form: the ellipsoids group.
 # Environment: HB (binary, default build/apps/hardbody/hardbody), WORK (run directories, default
 #   /tmp/hardbody-validate; GSD/log outputs stay there), SQ_P ("2 4 8 12 16"), SQ_X0 ("2 0.5"),
+#   HB_BUILD (label of the binary's source, stored in each summary as "build"; default HEAD),
 #   SQ_METHODS ("nnl cells"), SQ_SNAP (superquadrics group: time between the snapshots that
 #   get the overlap check, default 2.0; each check costs ~1 s of CPU at N = 512), E045 ("X0:N:a,b,c ..."), NICE (default 10), DEADLINE (epoch
 #   seconds: no run starts after it). Runs go one at a time. A failed run (exit 3)
@@ -109,10 +110,21 @@ run() {
     2> "$work/$name.stderr"
   rc=$?
   if [ $rc -eq 0 ]; then
-    cp "$work/$name/summary.json" "$out/runs/$name.summary.json"
+    # the summary, with the build that ran it (HB_BUILD, e.g. a commit; default: HEAD's)
+    /usr/bin/python3 - "$work/$name/summary.json" "$out/runs/$name.summary.json" \
+      "${HB_BUILD:-$(git rev-parse --short HEAD 2>/dev/null || echo unknown)}" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+s["build"] = sys.argv[3]
+json.dump(s, open(sys.argv[2], "w"), indent=1)
+PY
   else
     echo "$name: exit $rc" >&2
-    { echo "## $name: exit $rc ($(date -u +%F))"; echo; echo '```'
+    { echo "## $name: exit $rc ($(date -u +%F))"; echo
+      echo "build: ${HB_BUILD:-$(git rev-parse --short HEAD 2>/dev/null || echo unknown)}"
+      [ -f "$work/$name/log.tsv.part" ] && tail -n 1 "$work/$name/log.tsv.part" |
+        awk -F'\t' '{printf "reached: collisions %d, time %s\n", $2, $1}'
+      echo; echo '```'
       echo "$HB run $work/$name.toml --out $work/$name"; tail -n 20 "$work/$name.stderr"
       echo '```'; echo; } >> "$out/failures.md"
   fi
@@ -167,7 +179,7 @@ esac
 
 # the tables, rebuilt from every summary present
 /usr/bin/python3 - "$out" "$work" <<'PY'
-import glob, json, math, os, sys
+import glob, json, math, os, re, sys
 out, work = sys.argv[1], sys.argv[2]
 
 def late(name):
@@ -200,22 +212,24 @@ def fb(s):
             f"{v['collision_distance_fallbacks']}, contact {v['contact_fallbacks']})")
 
 def failed(prefix):
-    """Runs of failures.md named PREFIX*, with how far they got (runs/NAME.failed.json)."""
+    """Failures in failures.md of runs named PREFIX*, in file order: exit, message, build, and how
+    far the run got (the `reached:` line run() writes from the run's log at the time of failure)."""
     res, text = {}, open(f"{out}/failures.md").read() if os.path.exists(f"{out}/failures.md") else ""
     for part in text.split("## ")[1:]:
         head, body = part.split("\n", 1)
         name, rc = head.split(": exit ")
         if not name.startswith(prefix):
             continue
-        keep = f"{out}/runs/{name}.failed.json"
-        msg = [l for l in body.split("\n") if l.startswith("hardbody:")]
-        f = {"exit": int(rc.split()[0]), "message": msg[-1] if msg else ""}
-        part_log = f"{work}/{name}/log.tsv.part"
-        if os.path.exists(part_log):
-            last = open(part_log).read().strip().split("\n")[-1].split("\t")
-            f.update(time=float(last[0]), collisions=int(float(last[1])))
-            json.dump(f, open(keep, "w"), indent=1)
-        res[name] = json.load(open(keep)) if os.path.exists(keep) else f
+        lines = body.split("\n")
+        msg = [l for l in lines if l.startswith("hardbody:")]
+        build = [l[len("build: "):] for l in lines if l.startswith("build: ")]
+        f = {"exit": int(rc.split()[0]), "message": msg[-1] if msg else "",
+             "build": build[0] if build else "session 2"}
+        for l in lines:
+            m = re.match(r"reached: collisions (\d+), time ([0-9.eE+-]+)", l)
+            if m:
+                f.update(collisions=int(m.group(1)), time=float(m.group(2)))
+        res.setdefault(name, []).append(f)
     return res
 
 def write(name, lines):
@@ -274,20 +288,23 @@ rows = ["# Hard superquadrics at the paper's state point (scripts/validate.sh su
         "|x/a|^2 + |y/b|^2 + |z/c|^p <= 1 (the paper's section 5: n = m = 2, p varied), N = 512,",
         "phi = 0.256, smallest semi-axis 0.8 (X0 = 2: a = 1.6, b = c = 0.8; X0 = 0.5: a = 0.8,",
         "b = c = 1.6), I = 1, grown from phi0 = 0.1, equilibrated for 2 time units, snapshots every 2",
-        "time units. `overlaps` is the surface-sampling check (observers/overlap_sampling) of the",
-        "final state, `snapshot overlaps` the same check summed over all `snapshots`; drift is the",
-        "relative kinetic-energy change over the measured run; fallbacks are the solver's",
-        "(distance / collision-distance / contact-time). Summaries: runs/sq_*.summary.json.", "",
-        "The issue asks for 10^6 collisions per run; the runs below have the count in `collisions`",
-        "(2x10^5 where the time available allowed no more: 10^6 at tau_c ~ 300-600 us is 5-10 CPU",
-        "minutes per run, 20 runs did not fit). A missing (p, X0, method) row was not run.", "",
-        "| p | X0 | method | collisions | overlaps (final) | snapshot overlaps | snapshots | min gap (final / snapshots) | energy drift | fallbacks | Z | tau_c (us) | CPU s |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        "or 10 time units (SQ_SNAP; their number is in `snapshots`). `overlaps` is the surface-sampling",
+        "check (observers/overlap_sampling) of the final state, `snapshot overlaps` the same check",
+        "summed over all `snapshots`; drift is the relative kinetic-energy change over the measured",
+        "run; fallbacks are the solver's (distance / collision-distance / contact-time). `build` is",
+        "the source the binary was built from (runs of different builds are mixed in this table; a",
+        "run without the field predates it: session 2's build). tau_c is CPU time per collision on",
+        "the shared 2-core machine while other runs were going (not a benchmark: see",
+        "docs/performance.md). Summaries: runs/sq_*.summary.json.", "",
+        "The issue asks for 10^6 collisions per run; the count is in `collisions`. A missing",
+        "(p, X0, method) row was not run or failed (next table).", "",
+        "| p | X0 | method | collisions | overlaps (final) | snapshot overlaps | snapshots | min gap (final / snapshots) | energy drift | fallbacks | Z | tau_c (us) | CPU s | build |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
 for s, _ in sqrows("sq_X0_*"):
     a = s["shape"]["semi_axes"]
     rows.append(f"| {s['shape']['exponents'][2]:g} | {a[0] / a[1]:g} | {s['neighbors']} | {s['collisions']} | {s['overlaps']} | "
                 f"{s['snapshot_overlaps']} | {s['trajectory_frames']} | {s['min_distance']:.1e} / {s['snapshot_min_distance']:.1e} | "
-                f"{s['energy_drift']:.1e} | {fb(s)} | {s['Z']:.4f} ± {s['Z_error']:.4f} | {s['tau_c_us']:.0f} | {s['cpu_seconds']:.0f} |")
+                f"{s['energy_drift']:.1e} | {fb(s)} | {s['Z']:.4f} ± {s['Z_error']:.4f} | {s['tau_c_us']:.0f} | {s['cpu_seconds']:.0f} | {s.get('build', 'session 2')} |")
 rows += ["", "## Exponents [2, 2, 2] against the ellipsoid (same state, seed, start and collision count)", "",
          "| X0 | seed | shape | collisions | Z | collision rate | tau_c (us) |", "|---|---|---|---|---|---|---|"]
 for x0 in ["2", "0.5"]:
@@ -316,9 +333,14 @@ for x0 in ["2", "0.5"]:
 fails = failed("sq")
 if fails:
     rows += ["", "## Failed runs (exit 3; reproducer: `hardbody run CONFIG --out DIR --resume` from the checkpoint the run wrote, details in failures.md)", "",
-             "| run | exit | collisions reached (measured) | sim. time reached | message |", "|---|---|---|---|---|"]
-    for name, f in sorted(fails.items()):
-        rows.append(f"| {name} | {f['exit']} | {f.get('collisions', '-')} | {f.get('time', '-')} | {f['message']} |")
+             "Every failure is listed with the build that failed; `later` says whether a later build",
+             "completed the same run (then it is in the table above).", "",
+             "| run | build | exit | collisions reached (measured) | sim. time reached | later | message |", "|---|---|---|---|---|---|---|"]
+    for name, fl in sorted(fails.items()):
+        done = load(f"{out}/runs/{name}.summary.json") if os.path.exists(f"{out}/runs/{name}.summary.json") else None
+        for f in fl:
+            later = (f"completed with {done.get('build', 'session 2')}" if done and done.get("build", "session 2") != f["build"] else "-")
+            rows.append(f"| {name} | {f['build']} | {f['exit']} | {f.get('collisions', '-')} | {f.get('time', '-')} | {later} | {f['message'][:300]} |")
 taus = sqrows("sqtau_p*")
 if taus:
     rows += ["", "## Short runs for tau_c (scripts/validate.sh sq-taus: X0 = 2, NNL, snapshots every time unit)", "",
