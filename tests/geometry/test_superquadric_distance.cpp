@@ -24,6 +24,10 @@ namespace {
 using testing::Rng;
 using testing::scaled_count;
 
+// A pose from a position and a (not necessarily normalised) quaternion w, x, y, z, as in the
+// reproducers the runs print.
+Pose pose_of(const Vec3& r, const Quat& q) { return Pose{r, q.normalized().toRotationMatrix()}; }
+
 ref::SlowSuperquadric slow(const Superquadric& s) {
   return ref::SlowSuperquadric{s.a, s.b, s.c, s.n, s.m, s.p};
 }
@@ -405,16 +409,8 @@ TEST(SuperquadricDistance, FlatContactsSymmetricInAandB) {
 // stage used to fail.  The support-point stage (3) solves it.
 TEST(SuperquadricDistance, ValidationRunCollisionPair) {
   const Superquadric s{1.6, 0.8, 0.8, 2.0, 2.0, 16.0};
-  const Pose pa{Vec3(4.1605143753890799, 13.239776286550754, 1.4657836985252655),
-                Quat(0.17485445579330541, 0.8439727723483621, 0.50178144086915721,
-                     -0.073152337099503362)
-                    .normalized()
-                    .toRotationMatrix()};
-  const Pose pb{Vec3(5.1657140003484763, 15.564614253723166, 0.53882459518185144),
-                Quat(0.94309723891067654, -0.21034355408783792, 0.034857821104773076,
-                     0.25516292740244001)
-                    .normalized()
-                    .toRotationMatrix()};
+  const Pose pa = pose_of(Vec3(4.1605143753890799, 13.239776286550754, 1.4657836985252655), Quat(0.17485445579330541, 0.8439727723483621, 0.50178144086915721, -0.073152337099503362));
+  const Pose pb = pose_of(Vec3(5.1657140003484763, 15.564614253723166, 0.53882459518185144), Quat(0.94309723891067654, -0.21034355408783792, 0.034857821104773076, 0.25516292740244001));
   const DistanceResult ab = distance(s, pa, s, pb), ba = distance(s, pb, s, pa);
   const ref::RefDistance rd = slow_reference(s, pa, s, pb);
   std::printf("  validation pair: d %.3e (status %d, attempt %d, %d NR it.), d(B,A) %.3e, "
@@ -466,16 +462,8 @@ TEST(SuperquadricDistance, StraightWallsSideBySide) {
               n, worst, fallbacks, stage7);
 
   const Superquadric s{1.6, 0.8, 0.8, 2.0, 2.0, 16.0};
-  const Pose pa{Vec3(5.3006870825795032, 3.4957106036348962, 21.88440452217338),
-                Quat(0.21524146793120255, -0.028842014577787213, 0.89055009750116298,
-                     0.3996996028501717)
-                    .normalized()
-                    .toRotationMatrix()};
-  const Pose pb{Vec3(7.8902061075045893, 2.2386480189434135, 22.001266867053364),
-                Quat(-0.44003240494463225, 0.88045375374906398, -0.11633223959496848,
-                     0.13281370463414086)
-                    .normalized()
-                    .toRotationMatrix()};
+  const Pose pa = pose_of(Vec3(5.3006870825795032, 3.4957106036348962, 21.88440452217338), Quat(0.21524146793120255, -0.028842014577787213, 0.89055009750116298, 0.3996996028501717));
+  const Pose pb = pose_of(Vec3(7.8902061075045893, 2.2386480189434135, 22.001266867053364), Quat(-0.44003240494463225, 0.88045375374906398, -0.11633223959496848, 0.13281370463414086));
   const DistanceResult ab = distance(s, pa, s, pb), ba = distance(s, pb, s, pa);
   const ref::RefDistance rd = slow_reference(s, pa, s, pb);
   std::printf("  contact-time failure pair: d %.15g (attempt %d), d(B,A) %.15g (attempt %d), "
@@ -493,10 +481,8 @@ TEST(SuperquadricDistance, StraightWallsSideBySide) {
 // Stage 7 used to accept only positive maxima; a touching pair must give |d| at rounding level.
 TEST(SuperquadricDistance, JustCollidedFlatPairIsTouching) {
   const Superquadric s{0.8, 1.6, 1.6, 2.0, 2.0, 12.0};
-  const Pose pa{Vec3(3.637648057770667, 11.826317321173217, 21.307758097961653),
-                Quat(-0.6654538443604486, 0.028019301066517854, -0.7437050684021581, -0.05734867937960988).normalized().toRotationMatrix()};
-  const Pose pb{Vec3(3.299030342676802, 14.301695322165555, 22.792031348653875),
-                Quat(-0.13485383628412342, 0.635016533903404, 0.1916619467718254, -0.7360938409390448).normalized().toRotationMatrix()};
+  const Pose pa = pose_of(Vec3(3.637648057770667, 11.826317321173217, 21.307758097961653), Quat(-0.6654538443604486, 0.028019301066517854, -0.7437050684021581, -0.05734867937960988));
+  const Pose pb = pose_of(Vec3(3.299030342676802, 14.301695322165555, 22.792031348653875), Quat(-0.13485383628412342, 0.635016533903404, 0.1916619467718254, -0.7360938409390448));
   const DistanceResult ab = distance(s, pa, s, pb), ba = distance(s, pb, s, pa);
   const ref::RefDistance rd = slow_reference(s, pa, s, pb);
   std::printf("  just-collided pair: d %.3e (attempt %d), d(B,A) %.3e (attempt %d), reference %.3e\n",
