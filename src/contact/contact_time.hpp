@@ -667,4 +667,15 @@ ContactResult contact_time(const ContactInput<SA, SB>& in, const ContactOptions&
   return out;
 }
 
+// Compiled once for the engine's shape pairs (src/contact/contact_time_*.cpp; see the end of
+// geometry/distance.hpp).
+#define HB_CONTACT_INSTANCE(EXTERN, SA, SB) \
+  EXTERN template ContactResult contact_time<SA, SB>(const ContactInput<SA, SB>&, const ContactOptions&);
+#define HB_CONTACT_INSTANCES(EXTERN, SA) HB_FOR_EACH_ENGINE_SHAPE(HB_CONTACT_INSTANCE, EXTERN, SA)
+#ifndef HB_CONTACT_INSTANTIATE
+HB_CONTACT_INSTANCES(extern, Sphere)  // (not nested in HB_FOR_EACH_ENGINE_SHAPE: a macro cannot expand itself)
+HB_CONTACT_INSTANCES(extern, Ellipsoid)
+HB_CONTACT_INSTANCES(extern, Superquadric)
+#endif
+
 }  // namespace hb

@@ -109,6 +109,8 @@
 #include "math/types.hpp"
 #include "shapes/ellipsoid.hpp"
 #include "shapes/shape.hpp"
+#include "shapes/engine_shapes.hpp"
+#include "shapes/superquadric.hpp"
 
 namespace hb {
 
@@ -848,5 +850,18 @@ DistanceResult distance(const SA& a, const Pose& pa, const SB& b, const Pose& pb
   res.warm = DistanceWarmStart{p.xa, B.to_body(p.xb), res.alpha, p.beta, ok};
   return res;
 }
+
+// The solver for the engine's shape pairs (shapes/engine_shapes.hpp) is compiled once, in
+// src/geometry/distance_*.cpp, and linked by every other translation unit: instantiated in each of
+// them, it made the build (above all the sanitizer build) several times slower.
+#define HB_DISTANCE_INSTANCE(EXTERN, SA, SB)                                                    \
+  EXTERN template DistanceResult distance<SA, SB>(const SA&, const Pose&, const SB&, const Pose&, \
+                                                  const DistanceOptions&, const DistanceWarmStart*);
+#define HB_DISTANCE_INSTANCES(EXTERN, SA) HB_FOR_EACH_ENGINE_SHAPE(HB_DISTANCE_INSTANCE, EXTERN, SA)
+#ifndef HB_DISTANCE_INSTANTIATE
+HB_DISTANCE_INSTANCES(extern, Sphere)  // (not nested in HB_FOR_EACH_ENGINE_SHAPE: a macro cannot expand itself)
+HB_DISTANCE_INSTANCES(extern, Ellipsoid)
+HB_DISTANCE_INSTANCES(extern, Superquadric)
+#endif
 
 }  // namespace hb

@@ -262,7 +262,9 @@ TEST(Contact, JustTouchingCoarseEpsVsReference) {
   run_kind(4, scaled_count(1000, 0.002, 2), 46, st, 1e-2);
   st.print("touch,eps");
   EXPECT_EQ(st.hits, st.n);
-  if (st.n >= 50) EXPECT_GT(st.grazing, 0);  // the path is exercised (Release: ~500 searches)
+  if (st.n >= 50) {
+    EXPECT_GT(st.grazing, 0);  // the path is exercised (Release: ~500 searches)
+  }
 }
 // The same grazing passes with the coarse eps_d: Brent must not invent contacts.
 TEST(Contact, GrazingCoarseEpsVsReference) {

@@ -1,0 +1,8 @@
+// The contact-time solver for Sphere against every engine shape, compiled once (see the end of
+// contact/contact_time.hpp).
+#define HB_CONTACT_INSTANTIATE
+#include "contact/contact_time.hpp"
+
+namespace hb {
+HB_CONTACT_INSTANCES(, Sphere)
+}  // namespace hb
