@@ -110,7 +110,6 @@
 #include "shapes/ellipsoid.hpp"
 #include "shapes/shape.hpp"
 #include "shapes/engine_shapes.hpp"
-#include "shapes/superquadric.hpp"
 
 namespace hb {
 
