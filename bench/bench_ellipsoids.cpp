@@ -8,7 +8,7 @@
 #include <cstring>
 #include <ctime>
 
-#include "system/rigid_setup.hpp"
+#include "setup/rigid_setup.hpp"
 
 #include "bench_common.hpp"
 

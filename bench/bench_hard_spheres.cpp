@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <ctime>
 
-#include "system/sphere_setup.hpp"
+#include "setup/sphere_setup.hpp"
 
 #include "bench_common.hpp"
 

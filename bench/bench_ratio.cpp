@@ -64,19 +64,16 @@ int run(int argc, char** argv) {
   const LatticeCheck lat = check_lattice(pt);
   if (!lat.ok) throw std::invalid_argument(lat.reason);
   if (pair == "spheres") {
-    const hb::SphereSystemSpec ss = sphere_spec(pt.spec.n, pt.spec.phi, sphere_shell, pt.spec.seed);
     j["A_engine"] = sphere_shell > 0 ? "hard spheres, shell lists" : "hard spheres, cells";
     j["A_shell"] = sphere_shell;
     j["B_engine"] = "ellipsoids";
     j["B_point"] = describe(pt);
     with_rigid_simulation(pt, lattice_start_of(pt), [&](auto b) {
-      if (sphere_shell > 0) {
-        auto a = hb::make_hard_sphere_list_simulation(ss);
+      hb::assemble(sphere_config(pt.spec.n, pt.spec.phi, sphere_shell, pt.spec.seed), [&](const auto& as) {
+        hb::Start s = as.start();
+        auto a = as.simulate(s.box, std::move(s.state));
         compare(a, b, sphere_coll, coll, warm, rounds, j);
-      } else {
-        auto a = hb::make_hard_sphere_cell_simulation(ss);
-        compare(a, b, sphere_coll, coll, warm, rounds, j);
-      }
+      });
     });
   } else if (pair == "superquadric") {
     RigidPoint sq = pt;

@@ -30,7 +30,7 @@
 #include "observers/overlap.hpp"
 #include "observers/overlap_sampling.hpp"
 #include "observers/structure.hpp"
-#include "shapes/describe.hpp"
+#include "shapes/codec.hpp"
 
 #include "bench_rigid.hpp"
 

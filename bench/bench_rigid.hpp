@@ -14,8 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "system/rigid_setup.hpp"
-#include "system/sphere_setup.hpp"
+#include "setup/builder.hpp"
 
 #include "bench_common.hpp"
 
@@ -250,17 +249,6 @@ inline void put_costs(Json& j, const Tally& d) {
   j["fallbacks"] = d.fallbacks();
 }
 
-// Hard spheres of diameter 1 at the same N and phi (the hard-sphere engine; shell 0: cells).
-inline hb::SphereSystemSpec sphere_spec(std::size_t n, double phi, double shell, std::uint64_t seed) {
-  hb::SphereSystemSpec s;
-  s.n = n;
-  s.phi = phi;
-  s.sigma = 1.0;
-  s.shell = shell;
-  s.seed = seed;
-  return s;
-}
-
 // A configuration to start a simulation from: the lattice start of a point, or the synchronized
 // state of an earlier simulation (every body at time `now`).
 struct Start {
@@ -268,32 +256,62 @@ struct Start {
   hb::State state;
   double now = 0.0;
 };
+// The point as a run configuration: benchmarks assemble their systems with the same builder as
+// `hardbody run` and the Python module (setup/builder.hpp).
+inline hb::Config config_of(const RigidPoint& pt) {
+  hb::Config c;
+  c.source = "benchmark point";
+  c.particles = pt.spec.n;
+  c.packing_fraction = pt.spec.phi;
+  c.seed = pt.spec.seed;
+  c.temperature = pt.spec.kT;
+  c.mass = pt.spec.mass;
+  const Vec3 a = pt.spec.semi_axes, e = pt.spec.exponents;
+  if (pt.shape == "ellipsoid") c.shape = hb::Ellipsoid{a.x(), a.y(), a.z()};
+  else c.shape = hb::Superquadric{a.x(), a.y(), a.z(), e.x(), e.y(), e.z()};
+  c.inertia = pt.spec.inertia;
+  c.eps_d = pt.spec.eps_d;
+  c.neighbors_method = pt.method;
+  c.shell = pt.shell;
+  c.init_method = "lattice";
+  return c;
+}
+// Hard spheres of diameter 1 (shell 0: cell lists, else shell neighbour lists).
+inline hb::Config sphere_config(std::size_t n, double phi, double shell, std::uint64_t seed) {
+  hb::Config c;
+  c.source = "benchmark point";
+  c.particles = n;
+  c.packing_fraction = phi;
+  c.seed = seed;
+  c.shape = hb::Sphere{0.5};
+  c.neighbors_method = shell > 0.0 ? "nnl" : "cells";
+  c.shell = shell;
+  return c;
+}
+
+// Calls f(assembly) for a rigid-body configuration (the builder also knows spheres: not here).
+template <class F>
+void with_rigid_assembly(const hb::Config& c, F&& f) {
+  hb::assemble(c, [&](const auto& as) {
+    if constexpr (requires { as.model().shape; }) f(as);
+    else throw std::invalid_argument("not a rigid-body point");
+  });
+}
+
 inline Start lattice_start_of(const RigidPoint& pt) {
   Start st;
-  st.state = pt.shape == "ellipsoid" ? hb::ellipsoid_start(pt.spec, st.box)
-                                     : hb::superquadric_start(pt.spec, st.box);
+  with_rigid_assembly(config_of(pt), [&](const auto& as) {
+    hb::Start s = as.start();
+    st.box = s.box;
+    st.state = std::move(s.state);
+  });
   return st;
 }
 
 // Builds the simulation of a rigid point from `st` and hands it to f (a generic lambda).
 template <class F>
 void with_rigid_simulation(const RigidPoint& pt, Start st, F&& f) {
-  auto build = [&](auto model) {
-    using Model = decltype(model);
-    using S = decltype(model.shape);
-    if (pt.method == "cells") {
-      const hb::CellNeighbors nb(model.interaction_range());
-      f(hb::Simulation<Model, hb::CellNeighbors>(st.box, std::move(st.state), std::move(model), nb, st.now));
-    } else {
-      hb::ObbNeighbors<S> nb(model.shape, pt.shell);
-      f(hb::Simulation<Model, hb::ObbNeighbors<S>>(st.box, std::move(st.state), std::move(model),
-                                                   std::move(nb), st.now));
-    }
-  };
-  if (pt.shape == "ellipsoid")
-    build(hb::ellipsoid_model(pt.spec));
-  else
-    build(hb::superquadric_model(pt.spec));
+  with_rigid_assembly(config_of(pt), [&](const auto& as) { f(as.simulate(st.box, std::move(st.state), st.now)); });
 }
 
 // main() of a benchmark: bad arguments and unexpected errors exit with status 2 and one message.

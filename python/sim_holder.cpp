@@ -7,21 +7,18 @@
 #include <utility>
 
 #include "io/checkpoint.hpp"
-#include "io/plan.hpp"
-#include "system/init.hpp"
-#include "system/rigid_setup.hpp"
-#include "system/sphere_setup.hpp"
+#include "io/run.hpp"
+#include "setup/builder.hpp"
 
 namespace hb::python {
 
 namespace {
 
-// The simulation plus the two things the driver knows about the bodies beyond the event loop.
-template <class Sim, class Kinetic, class Overlaps>
+// The simulation plus what the builder knows about its bodies beyond the event loop.
+template <class Sim>
 class Holder final : public SimHandle {
  public:
-  Holder(Sim sim, double mass, Kinetic kinetic, Overlaps overlaps)
-      : sim_(std::move(sim)), mass_(mass), kinetic_(kinetic), overlaps_(overlaps) {}
+  Holder(Sim sim, SystemOps ops) : sim_(std::move(sim)), ops_(std::move(ops)) {}
 
   double now() const override { return sim_.now(); }
   std::uint64_t collisions() const override { return sim_.collisions(); }
@@ -29,11 +26,9 @@ class Holder final : public SimHandle {
   std::array<std::uint64_t, kEventTypes> event_counts() const override { return sim_.event_counts(); }
   const Box& box() const override { return sim_.box(); }
   State synchronized() const override { return synchronized_state(sim_); }
-  double kinetic_energy() const override { return kinetic_(sim_.state()); }
-  double temperature() const override {
-    return 2.0 * hb::kinetic_energy(sim_.state(), mass_) / (3.0 * double(sim_.state().size()));
-  }
-  OverlapReport overlaps() const override { return overlaps_(synchronized_state(sim_), sim_.box()); }
+  double kinetic_energy() const override { return ops_.kinetic(sim_.state()); }
+  double temperature() const override { return ops_.temperature(sim_.state()); }
+  OverlapReport overlaps() const override { return ops_.overlaps(synchronized_state(sim_), sim_.box()); }
 
   Stop advance(double t_end, std::uint64_t max_collisions, VirialPressure& pressure,
                const std::function<void()>& poll) override {
@@ -52,70 +47,30 @@ class Holder final : public SimHandle {
 
  private:
   Sim sim_;
-  double mass_;
-  Kinetic kinetic_;
-  Overlaps overlaps_;
+  SystemOps ops_;
 };
 
-template <class Sim, class K, class O>
-std::unique_ptr<SimHandle> hold(Sim sim, double mass, K kinetic, O overlaps) {
-  return std::make_unique<Holder<Sim, K, O>>(std::move(sim), mass, kinetic, overlaps);
-}
-
-std::unique_ptr<SimHandle> spheres(const Config& c, const Box* box, const State* start) {
-  const SphereSystemSpec spec = plan_spheres(c);  // the run driver's checks and messages
-  auto kinetic = [m = spec.mass](const State& s) { return hb::kinetic_energy(s, m); };
-  auto overlaps = [sigma = spec.sigma](const State& s, const Box& b) {
-    return sphere_overlaps(s.r, b, sigma);
-  };
-  if (start) {
-    const HardSpheres model{spec.sigma, spec.mass};
-    if (spec.shell > 0.0)
-      return hold(SphereListSim(*box, *start, model, ShellNeighbors(spec.sigma, spec.shell)),
-                  spec.mass, kinetic, overlaps);
-    return hold(SphereCellSim(*box, *start, model, CellNeighbors(spec.sigma)), spec.mass, kinetic,
-                overlaps);
-  }
-  if (spec.shell > 0.0)
-    return hold(make_hard_sphere_list_simulation(spec), spec.mass, kinetic, overlaps);
-  return hold(make_hard_sphere_cell_simulation(spec), spec.mass, kinetic, overlaps);
-}
-
-std::unique_ptr<SimHandle> ellipsoids(const Config& c, const Box* box, const State* start) {
-  const RigidSystemSpec spec = plan_ellipsoids(c);
-  const auto proto = ellipsoid_model(spec);
-  auto kinetic = [proto](const State& s) { return proto.kinetic_energy(s); };
-  auto overlaps = [axes = spec.semi_axes](const State& s, const Box& b) {
-    return ellipsoid_overlaps(s.r, s.q, b, axes);
-  };
-  if (start) {
-    if (c.neighbors_method == "nnl")
-      return hold(EllipsoidListSim(*box, *start, ellipsoid_model(spec),
-                                   ObbNeighbors<Ellipsoid>(proto.shape, c.shell)),
-                  spec.mass, kinetic, overlaps);
-    return hold(EllipsoidCellSim(*box, *start, ellipsoid_model(spec),
-                                 CellNeighbors(proto.interaction_range())),
-                spec.mass, kinetic, overlaps);
-  }
-  if (c.neighbors_method == "nnl")
-    return hold(make_ellipsoid_list_simulation(spec, c.shell), spec.mass, kinetic, overlaps);
-  return hold(make_ellipsoid_cell_simulation(spec), spec.mass, kinetic, overlaps);
-}
-
-}  // namespace
-
-namespace {
+// The builder's assembly of the config, started from its own start (lattice or growth, as
+// `hardbody run` does) or from the given bodies.
 std::unique_ptr<SimHandle> build(const Config& c, const Box* box, const State* start) {
+  std::unique_ptr<SimHandle> h;
   try {
-    if (c.shape.type == "sphere") return spheres(c, box, start);
-    if (c.shape.type == "ellipsoid") return ellipsoids(c, box, start);
+    assemble(c, [&](const auto& as) {
+      using Sim = typename std::decay_t<decltype(as)>::Sim;
+      if (start) {
+        h = std::make_unique<Holder<Sim>>(as.simulate(*box, *start), as.ops());
+      } else {
+        Start s = as.start();
+        h = std::make_unique<Holder<Sim>>(as.simulate(s.box, std::move(s.state)), as.ops());
+      }
+    });
   } catch (const std::invalid_argument& e) {  // the lattice starts reject a too dense system
     throw ConfigError(fmt::format("{}: key 'system.packing_fraction': {} ({} particles at {})",
                                   c.source, e.what(), c.particles, c.packing_fraction));
   }
-  throw ConfigError(fmt::format("{}: key 'shape.type': '{}' bodies are not yet supported", c.source,
-                                c.shape.type));
+  return h;
 }
+
 }  // namespace
 
 std::unique_ptr<SimHandle> make_simulation(const Config& c) { return build(c, nullptr, nullptr); }

@@ -239,7 +239,7 @@ def header(rep):
           "X0 = a/b and phi = pi X0 b^3 rho / 6 with b the full minor length (ERRATA 8), so lengths are in "
           "units of the equatorial diameter, the NNL shell too (Delta_NNL = 0.15 as in the paper). "
           "Spherical tops with I = 2/5 m r^2, r the smallest semi-axis; kT = m = 1; eps_d = 1e-5 unless varied.",
-          "* Start: the aligned stretched FCC lattice (`src/system/rigid_setup.hpp`) melted by the warm-up. "
+          "* Start: the aligned stretched FCC lattice (`src/setup/rigid_setup.hpp`) melted by the warm-up. "
           "The paper started from grown, equilibrated isotropic liquids. The final nematic order S2 of each run "
           "is in the CSV. Values near 0.1 or below mean isotropic at N = 256; values near 1 mean the run stayed "
           "aligned (the nematic states at large X0 or 1/X0).",

@@ -109,7 +109,7 @@
 #include "math/types.hpp"
 #include "shapes/ellipsoid.hpp"
 #include "shapes/shape.hpp"
-#include "shapes/engine_shapes.hpp"
+#include "shapes/registry.hpp"
 
 namespace hb {
 
@@ -850,7 +850,7 @@ DistanceResult distance(const SA& a, const Pose& pa, const SB& b, const Pose& pb
   return res;
 }
 
-// The solver for the engine's shape pairs (shapes/engine_shapes.hpp) is compiled once, in
+// The solver for the engine's shape pairs (shapes/registry.hpp) is compiled once, in
 // src/geometry/distance_*.cpp, and linked by every other translation unit: instantiated in each of
 // them, it made the build (above all the sanitizer build) several times slower.
 #define HB_DISTANCE_INSTANCE(EXTERN, SA, SB)                                                    \

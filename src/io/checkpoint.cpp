@@ -1,5 +1,8 @@
 #include "io/checkpoint.hpp"
 
+#include "io/shape_io.hpp"
+#include "shapes/codec.hpp"
+
 namespace hb::ckpt {
 
 namespace {
@@ -38,25 +41,36 @@ gsd::LogArray encode(const std::vector<std::array<int, 3>>& c) {
 }
 gsd::LogArray encode(const std::vector<Vec3>& c) { return vec3s(c); }
 
-const std::vector<std::string>& config_signature_names() {
-  static const std::vector<std::string> n = {
-      "system.particles", "system.packing_fraction", "system.seed", "system.temperature",
-      "system.mass", "shape.type", "shape.radius", "shape.semi_axes[0]", "shape.semi_axes[1]",
-      "shape.semi_axes[2]", "shape.exponents[0]", "shape.exponents[1]", "shape.exponents[2]",
-      "shape.inertia", "neighbors.method", "neighbors.shell", "solver.eps_d"};
-  return n;
-}
-std::vector<double> config_signature(const Config& c) {
-  const double type = c.shape.type == "sphere" ? 0 : c.shape.type == "ellipsoid" ? 1 : 2;
-  const double method = c.neighbors_method == "cells" ? 0 : 1;
-  return {double(c.particles), c.packing_fraction, double(c.seed), c.temperature, c.mass, type,
-          c.shape.radius, c.shape.semi_axes[0], c.shape.semi_axes[1], c.shape.semi_axes[2],
-          c.shape.exponents[0], c.shape.exponents[1], c.shape.exponents[2], c.shape.inertia,
-          method, c.shell, c.eps_d};
+// The keys a checkpoint must agree on with the config that resumes it; the shape's part is its
+// type (registry index) and the parameters of its codec entry.
+ConfigSignature config_signature(const Config& c) {
+  struct W final : ParamWriter {
+    ConfigSignature sig;
+    void add(std::string name, double v) {
+      sig.names.push_back(std::move(name));
+      sig.values.push_back(v);
+    }
+    void number(std::string_view k, double v) override { add(fmt::format("shape.{}", k), v); }
+    void triple(std::string_view k, const Vec3& v) override {
+      for (int i = 0; i < 3; ++i) add(fmt::format("shape.{}[{}]", k, i), v[i]);
+    }
+  } w;
+  w.add("system.particles", double(c.particles));
+  w.add("system.packing_fraction", c.packing_fraction);
+  w.add("system.seed", double(c.seed));
+  w.add("system.temperature", c.temperature);
+  w.add("system.mass", c.mass);
+  w.add("shape.type", double(c.shape.index()));
+  encode_shape(c.shape, w);
+  w.add("shape.inertia", c.inertia);
+  w.add("neighbors.method", c.neighbors_method == "cells" ? 0 : 1);
+  w.add("neighbors.shell", c.shell);
+  w.add("solver.eps_d", c.eps_d);
+  return std::move(w.sig);
 }
 
 void fill_frame(gsd::HoomdFrame& f, const State& s, const Box& box, double now, std::uint64_t step,
-                const ShapeSpec& shape) {
+                const AnyShape& shape) {
   const std::size_t n = s.size();
   f.step = step;
   f.N = static_cast<std::uint32_t>(n);
@@ -78,14 +92,8 @@ void fill_frame(gsd::HoomdFrame& f, const State& s, const Box& box, double now, 
     f.orientation[4 * i + 2] = float(s.q[i].y());
     f.orientation[4 * i + 3] = float(s.q[i].z());
   }
-  f.types = {shape.type};
-  if (shape.type == "sphere")
-    f.type_shapes = {gsd::sphere_shape(2.0 * shape.radius)};
-  else if (shape.type == "superquadric")
-    f.type_shapes = {gsd::superquadric_shape({shape.semi_axes.x(), shape.semi_axes.y(), shape.semi_axes.z()},
-                                             {shape.exponents.x(), shape.exponents.y(), shape.exponents.z()})};
-  else
-    f.type_shapes = {gsd::ellipsoid_shape(shape.semi_axes.x(), shape.semi_axes.y(), shape.semi_axes.z())};
+  f.types = {std::string(shape_name(shape))};
+  f.type_shapes = {gsd_type_shape(shape)};
   // Exact state in the engine's frame [0, L) (box_origin 0), for analysis and conversion.
   f.log[key("position_double")] = vec3s(s.r);
   f.log[key("orientation_double")] = quats(s.q);
@@ -125,7 +133,7 @@ void add_checkpoint_logs(gsd::HoomdFrame& f, const State& s, const LoopSnapshot&
   f.log["hardbody/obs_correlations"] = row(d.corr);
   f.log["hardbody/obs_gr"] = row(d.gr);
   f.log["hardbody/obs_nematic"] = row(d.nematic);
-  f.log["hardbody/config"] = row(config_signature(c));
+  f.log["hardbody/config"] = row(config_signature(c).values);
 }
 
 const gsd::LogArray& Reader::get(const std::string& k, std::uint64_t rows, std::uint32_t cols) const {
@@ -178,15 +186,14 @@ Reader open(const std::string& path, const Config& c) {
     throw InputError(e.what());
   }
   const auto sig = r.row("hardbody/config");
-  const auto want = config_signature(c);
-  const auto& names = config_signature_names();
-  if (sig.size() != want.size())
-    throw InputError(fmt::format("{}: checkpoint from an incompatible hardbody version", path));
-  for (std::size_t k = 0; k < want.size(); ++k)
-    if (sig[k] != want[k])
+  const ConfigSignature want = config_signature(c);
+  for (std::size_t k = 0; k < std::min(want.values.size(), sig.size()); ++k)
+    if (sig[k] != want.values[k])
       throw InputError(fmt::format(
           "{}: checkpoint was written with a different configuration ({} = {} there, {} in {})",
-          path, names[k], sig[k], want[k], c.source));
+          path, want.names[k], sig[k], want.values[k], c.source));
+  if (sig.size() != want.values.size())
+    throw InputError(fmt::format("{}: checkpoint from an incompatible hardbody version", path));
   if (r.f.N != c.particles)
     throw InputError(fmt::format("{}: checkpoint has {} particles, config {}", path, r.f.N, c.particles));
   return r;

@@ -51,10 +51,13 @@ gsd::LogArray scalars(const std::vector<double>& v);
 gsd::LogArray row(const std::vector<double>& v);
 gsd::LogArray events(const std::vector<Event>& e);
 gsd::LogArray cells(const std::vector<std::array<int, 3>>& c);
-std::vector<double> config_signature(const Config& c);
-const std::vector<std::string>& config_signature_names();
+struct ConfigSignature {
+  std::vector<std::string> names;
+  std::vector<double> values;
+};
+ConfigSignature config_signature(const Config& c);
 void fill_frame(gsd::HoomdFrame& f, const State& synced, const Box& box, double now,
-                std::uint64_t step, const ShapeSpec& shape);
+                std::uint64_t step, const AnyShape& shape);
 void add_checkpoint_logs(gsd::HoomdFrame& f, const State& s, const LoopSnapshot& loop,
                          const DriverState& d, const Config& c);
 
@@ -80,14 +83,14 @@ gsd::LogArray encode(const ObbSnapshot& c);
 
 // One trajectory frame (synchronised positions) at the simulation's current time.
 template <class Sim>
-gsd::HoomdFrame make_frame(const Sim& sim, const ShapeSpec& shape, bool, const void*) {
+gsd::HoomdFrame make_frame(const Sim& sim, const AnyShape& shape, bool, const void*) {
   gsd::HoomdFrame f;
   ckpt::fill_frame(f, synchronized_state(sim), sim.box(), sim.now(), sim.collisions(), shape);
   return f;
 }
 
 template <class Sim>
-gsd::HoomdFrame make_checkpoint(const Sim& sim, const ShapeSpec& shape, const Config& c,
+gsd::HoomdFrame make_checkpoint(const Sim& sim, const AnyShape& shape, const Config& c,
                                 const DriverState& d) {
   gsd::HoomdFrame f = make_frame(sim, shape, true, nullptr);
   ckpt::add_checkpoint_logs(f, sim.state(), sim.snapshot(), d, c);

@@ -1,5 +1,6 @@
 #include "io/config.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -7,23 +8,11 @@
 #include <sstream>
 #include <toml++/toml.h>
 
+#include "shapes/codec.hpp"
+
 #include <fmt/format.h>
 
 namespace hb {
-
-double ShapeSpec::volume() const {
-  if (type == "sphere") return 4.0 / 3.0 * kPi * radius * radius * radius;
-  const double abc = semi_axes.prod();
-  if (type == "ellipsoid") return 4.0 / 3.0 * kPi * abc;
-  // superquadric |x/a|^n + |y/b|^m + |z/c|^p <= 1
-  const double n = exponents.x(), m = exponents.y(), p = exponents.z();
-  return 8.0 * abc * std::tgamma(1 + 1 / n) * std::tgamma(1 + 1 / m) * std::tgamma(1 + 1 / p) /
-         std::tgamma(1 + 1 / n + 1 / m + 1 / p);
-}
-
-double ShapeSpec::max_semi_axis() const {
-  return type == "sphere" ? radius : semi_axes.maxCoeff();
-}
 
 namespace {
 
@@ -34,9 +23,6 @@ const std::map<std::string, std::map<std::string, Kind>>& schema() {
       {"system",
        {{"particles", Kind::Int}, {"packing_fraction", Kind::Float}, {"seed", Kind::Int},
         {"temperature", Kind::Float}, {"mass", Kind::Float}}},
-      {"shape",
-       {{"type", Kind::String}, {"radius", Kind::Float}, {"semi_axes", Kind::Vec3},
-        {"exponents", Kind::Vec3}, {"inertia", Kind::Float}}},
       {"run", {{"equilibrate_time", Kind::Float}, {"time", Kind::Float}, {"max_collisions", Kind::Int}}},
       {"neighbors", {{"method", Kind::String}, {"shell", Kind::Float}}},
       {"solver", {{"eps_d", Kind::Float}}},
@@ -50,6 +36,14 @@ const std::map<std::string, std::map<std::string, Kind>>& schema() {
         {"gr_bins", Kind::Int}}},
   };
   return s;
+}
+
+// Keys of [shape]: its type, the scalar inertia, and the parameters of every registered shape
+// (which ones apply to the chosen type is checked when the shape is decoded).
+bool is_shape_section_key(const std::string& key) {
+  if (key == "type" || key == "inertia") return true;
+  const auto keys = all_shape_keys();
+  return std::find(keys.begin(), keys.end(), key) != keys.end();
 }
 
 const char* kind_name(Kind k) {
@@ -126,10 +120,68 @@ struct Reader {
   }
 };
 
+// The [shape] table as the shape codec's parameters; messages name the key and its line.
+struct TomlShapeParams final : ParamReader {
+  const Reader& r;
+  std::string type;
+  TomlShapeParams(const Reader& rr, std::string t) : r(rr), type(std::move(t)) {}
+  bool has(std::string_view key) const override { return r.get("shape", std::string(key)) != nullptr; }
+  const toml::node* need(std::string_view key) const {
+    const auto* n = r.get("shape", std::string(key));
+    if (!n) throw ConfigError(fmt::format("{}: missing key 'shape.{}'", r.file, key));
+    return n;
+  }
+  double number(std::string_view key) const override {
+    return r.num(need(key), "shape." + std::string(key));
+  }
+  Vec3 triple(std::string_view key) const override {
+    Vec3 v;
+    need(key);
+    r.vec3("shape", std::string(key), v);
+    return v;
+  }
+  [[noreturn]] void fail(std::string_view key, const std::string& what) const override {
+    r.fail(r.get("shape", std::string(key)), "shape." + std::string(key), what);
+  }
+};
+
+// The shape's type and parameters as a TOML table (to_toml).
+toml::table shape_to_toml(const AnyShape& s) {
+  struct W final : ParamWriter {
+    toml::table t;
+    void number(std::string_view k, double v) override { t.insert(k, v); }
+    void triple(std::string_view k, const Vec3& v) override { t.insert(k, toml::array{v.x(), v.y(), v.z()}); }
+  } w;
+  w.t.insert("type", std::string(shape_name(s)));
+  encode_shape(s, w);
+  return std::move(w.t);
+}
+
+AnyShape read_shape(const Reader& r, const std::string& type) {
+  const TomlShapeParams params(r, type);
+  if (!is_shape_name(type)) params.fail("type", fmt::format("unknown shape type '{}' ({})", type, shape_names()));
+  if (const auto* t = r.root.get_as<toml::table>("shape"))
+    for (const auto& [k, v] : *t) {
+      const std::string key(k.str());
+      if (key != "type" && key != "inertia" && !is_shape_key(type, key))
+        params.fail(key, fmt::format("does not apply to shape type '{}' (its keys: {})", type,
+                                     shape_keys(type)));
+    }
+  return decode_shape(type, params);
+}
+
 void check_unknown_keys(const std::string& file, const toml::table& root) {
   const auto& s = schema();
   for (const auto& [k, v] : root) {
     const std::string sec(k.str());
+    if (sec == "shape") {
+      const auto* t = v.as_table();
+      if (!t) throw ConfigError(fmt::format("{}: 'shape' must be a table [shape]", where(file, v)));
+      for (const auto& [kk, vv] : *t)
+        if (!is_shape_section_key(std::string(kk.str())))
+          throw ConfigError(fmt::format("{}: unknown key 'shape.{}'", where(file, vv), kk.str()));
+      continue;
+    }
     auto it = s.find(sec);
     if (it == s.end()) {
       throw ConfigError(fmt::format("{}: unknown section or key '{}'", where(file, v), sec));
@@ -193,11 +245,9 @@ Config validate(const std::string& file, const toml::table& root) {
   r.integer("system", "seed", c.seed);
   r.real("system", "temperature", c.temperature);
   r.real("system", "mass", c.mass);
-  r.string("shape", "type", c.shape.type);
-  r.real("shape", "radius", c.shape.radius);
-  r.vec3("shape", "semi_axes", c.shape.semi_axes);
-  r.vec3("shape", "exponents", c.shape.exponents);
-  r.real("shape", "inertia", c.shape.inertia);
+  std::string type;
+  r.string("shape", "type", type);
+  r.real("shape", "inertia", c.inertia);
   r.real("run", "equilibrate_time", c.equilibrate_time);
   r.real("run", "time", c.time);
   r.integer("run", "max_collisions", c.max_collisions);
@@ -228,49 +278,19 @@ Config validate(const std::string& file, const toml::table& root) {
   if (!(c.temperature > 0.0)) bad("system", "temperature", "must be positive");
   if (!(c.mass > 0.0)) bad("system", "mass", "must be positive");
 
-  const std::string& t = c.shape.type;
-  if (t == "sphere") {
-    if (r.get("shape", "semi_axes") || r.get("shape", "exponents"))
-      bad("shape", r.get("shape", "semi_axes") ? "semi_axes" : "exponents",
-          "does not apply to shape type 'sphere' (use radius)");
-    if (!(c.shape.radius > 0.0))
-      bad("shape", "radius", fmt::format("must be positive (got {})", c.shape.radius));
-    c.shape.semi_axes = Vec3::Constant(c.shape.radius);
-    // random close packing is 0.64, the densest packing 0.7405
-    if (c.packing_fraction >= 0.74)
-      bad("system", "packing_fraction",
-          fmt::format("{} is not below 0.74 (the densest sphere packing is 0.7405)",
-                      c.packing_fraction));
-  } else if (t == "ellipsoid" || t == "superquadric") {
-    if (r.get("shape", "radius")) bad("shape", "radius", fmt::format("does not apply to shape type '{}' (use semi_axes)", t));
-    if (!r.get("shape", "semi_axes")) throw ConfigError(fmt::format("{}: missing key 'shape.semi_axes'", file));
-    for (int k = 0; k < 3; ++k)
-      if (!(c.shape.semi_axes[k] > 0.0))
-        bad("shape", "semi_axes", "every semi-axis must be positive");
-    if (t == "superquadric") {
-      if (!r.get("shape", "exponents")) throw ConfigError(fmt::format("{}: missing key 'shape.exponents'", file));
-      for (int k = 0; k < 3; ++k)
-        if (!(c.shape.exponents[k] >= 2.0))
-          bad("shape", "exponents", "every exponent must be >= 2 (smooth convex body)");
-    } else if (r.get("shape", "exponents")) {
-      bad("shape", "exponents", "applies only to shape type 'superquadric'");
-    }
-    if (c.packing_fraction >= 0.7707)
-      bad("system", "packing_fraction",
-          fmt::format("{} is not below 0.7707 (the densest known ellipsoid packing)",
-                      c.packing_fraction));
-  } else {
-    bad("shape", "type", fmt::format("unknown shape type '{}' (sphere, ellipsoid, superquadric)", t));
-  }
-  if (r.get("shape", "inertia") && !(c.shape.inertia > 0.0))
+  c.shape = read_shape(r, type);
+  const PackingLimit lim = packing_limit(c.shape);
+  if (c.packing_fraction >= lim.phi)
+    bad("system", "packing_fraction",
+        fmt::format("{} is not below {} ({})", c.packing_fraction, lim.phi, lim.note));
+  if (r.get("shape", "inertia") && !(c.inertia > 0.0))
     bad("shape", "inertia", "must be positive");
-  if (c.shape.inertia == 0.0) {
-    const double rmin = c.shape.semi_axes.minCoeff();
-    c.shape.inertia = 0.4 * c.mass * rmin * rmin;
-  }
+  if (c.inertia == 0.0) c.inertia = 0.4 * c.mass * sqr(half_extents(c.shape).minCoeff());
   if (c.equilibrate_time < 0.0) bad("run", "equilibrate_time", "must not be negative");
   if (!(c.time > 0.0)) bad("run", "time", "must be positive");
-  if (!r.get("neighbors", "method")) c.neighbors_method = t == "sphere" ? "cells" : "nnl";
+  // cells for spheres (their analytic contact times are cheap), neighbour lists otherwise
+  if (!r.get("neighbors", "method"))
+    c.neighbors_method = std::holds_alternative<Sphere>(c.shape) ? "cells" : "nnl";
   if (c.neighbors_method != "cells" && c.neighbors_method != "nnl")
     bad("neighbors", "method", fmt::format("must be \"cells\" or \"nnl\" (got \"{}\")", c.neighbors_method));
   if (!(c.shell > 0.0)) bad("neighbors", "shell", "must be positive");
@@ -319,15 +339,8 @@ Config load_config(const std::string& path, const std::vector<std::string>& over
 
 std::string to_toml(const Config& c) {
   auto arr = [](const Vec3& v) { return toml::array{v.x(), v.y(), v.z()}; };
-  toml::table shape;
-  shape.insert("type", c.shape.type);
-  if (c.shape.type == "sphere") {
-    shape.insert("radius", c.shape.radius);
-  } else {
-    shape.insert("semi_axes", arr(c.shape.semi_axes));
-    if (c.shape.type == "superquadric") shape.insert("exponents", arr(c.shape.exponents));
-  }
-  shape.insert("inertia", c.shape.inertia);
+  toml::table shape = shape_to_toml(c.shape);
+  shape.insert("inertia", c.inertia);
   toml::table root{
       {"system", toml::table{{"particles", int64_t(c.particles)},
                              {"packing_fraction", c.packing_fraction},

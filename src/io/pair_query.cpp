@@ -8,15 +8,13 @@
 #include "contact/contact_time.hpp"
 #include "geometry/distance.hpp"
 #include "io/run.hpp"
-#include "shapes/ellipsoid.hpp"
-#include "shapes/superquadric.hpp"
+#include "io/shape_io.hpp"
 
 namespace hb {
 
 namespace {
 
 using json = nlohmann::json;
-using AnyShape = std::variant<Sphere, Ellipsoid, Superquadric>;
 
 struct Where {
   const std::string& source;
@@ -50,26 +48,7 @@ Eigen::VectorXd numbers(const json& j, const char* key, int n, const Where& w) {
 
 AnyShape parse_shape(const json& j, const Where& w) {
   if (!j.is_object()) w.fail("'shape' must be an object");
-  if (!j.contains("type") || !j["type"].is_string()) w.fail("shape: missing string key 'type'");
-  const std::string t = j["type"];
-  if (t == "sphere") {
-    const double r = number(j, "radius", w);
-    if (!(r > 0.0)) w.fail("shape: radius must be positive");
-    return Sphere{r};
-  }
-  if (t == "ellipsoid") {
-    const Eigen::VectorXd s = numbers(j, "semi_axes", 3, w);
-    if (!(s.minCoeff() > 0.0)) w.fail("shape: every semi-axis must be positive");
-    return Ellipsoid{s[0], s[1], s[2]};
-  }
-  if (t == "superquadric") {
-    const Eigen::VectorXd s = numbers(j, "semi_axes", 3, w);
-    const Eigen::VectorXd e = numbers(j, "exponents", 3, w);
-    if (!(s.minCoeff() > 0.0)) w.fail("shape: every semi-axis must be positive");
-    if (!(e.minCoeff() >= 2.0)) w.fail("shape: every exponent must be >= 2");
-    return Superquadric{s[0], s[1], s[2], e[0], e[1], e[2]};
-  }
-  w.fail(fmt::format("unknown shape type '{}'", t));
+  return shape_from_json(j, [&](const std::string& what) { w.fail(what); });
 }
 
 struct Body {

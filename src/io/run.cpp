@@ -17,17 +17,14 @@
 #include "io/config.hpp"
 #include "io/files.hpp"
 #include "io/gsd_hoomd.hpp"
-#include "io/plan.hpp"
 #include "io/progress.hpp"
+#include "io/shape_io.hpp"
 #include "observers/correlations.hpp"
 #include "observers/overlap.hpp"
 #include "observers/overlap_sampling.hpp"
 #include "observers/structure.hpp"
 #include "observers/thermo.hpp"
-#include "system/init.hpp"
-#include "system/growth.hpp"
-#include "system/rigid_setup.hpp"
-#include "system/sphere_setup.hpp"
+#include "setup/builder.hpp"
 
 namespace hb {
 
@@ -60,18 +57,6 @@ double cpu_seconds() {
 
 std::string default_out_dir(const std::string& config_path) {
   return "run-" + std::filesystem::path(config_path).stem().string();
-}
-
-nlohmann::json shape_json(const ShapeSpec& s) {
-  nlohmann::json j;
-  j["type"] = s.type;
-  if (s.type == "sphere") {
-    j["radius"] = s.radius;
-  } else {
-    j["semi_axes"] = {s.semi_axes.x(), s.semi_axes.y(), s.semi_axes.z()};
-    if (s.type == "superquadric") j["exponents"] = {s.exponents.x(), s.exponents.y(), s.exponents.z()};
-  }
-  return j;
 }
 
 // Rows of log.tsv, kept in log.tsv.part while running and renamed at the end.
@@ -134,13 +119,6 @@ void truncate_trajectory(const std::string& path, std::uint64_t frames) {
   std::filesystem::rename(tmp, path);
 }
 
-// What the driver needs to know about the bodies beyond the event loop.
-struct SystemOps {
-  std::function<double(const State&)> kinetic;  // total kinetic energy (translation + rotation)
-  std::function<OverlapReport(const State&, const Box&)> overlaps;  // independent check, synced state
-  std::shared_ptr<nlohmann::json> extra = std::make_shared<nlohmann::json>(nlohmann::json::object());  // merged into summary.json
-};
-
 class Interrupted : public std::runtime_error {
  public:
   explicit Interrupted(int sig) : std::runtime_error("interrupted"), signal(sig) {}
@@ -152,8 +130,9 @@ template <class Sim>
 class Driver {
  public:
   Driver(const Config& cfg, const RunOptions& opt, const std::string& dir, Sim& sim,
-         const DriverState& st, const ShapeSpec& shape, const SystemOps& ops)
-      : cfg_(cfg), opt_(opt), dir_(dir), sim_(sim), st_(st), shape_(shape), ops_(ops),
+         const DriverState& st, const SystemOps& ops, nlohmann::json extra)
+      : cfg_(cfg), opt_(opt), dir_(dir), sim_(sim), st_(st), shape_(cfg.shape), ops_(ops),
+        extra_(std::move(extra)),
         corr_(correlation_spec(cfg)), rdf_(rdf_spec(cfg)) {
     if (!st_.pressure.empty()) pressure_.load(st_.pressure);
     if (!st_.corr.empty()) corr_.load(st_.corr);
@@ -330,9 +309,9 @@ class Driver {
 
     nlohmann::json j;
     j["particles"] = n;
-    j["packing_fraction"] = double(n) * cfg_.shape.volume() / sim_.box().volume();
+    j["packing_fraction"] = double(n) * volume(cfg_.shape) / sim_.box().volume();
     j["box"] = {sim_.box().L.x(), sim_.box().L.y(), sim_.box().L.z()};
-    j["shape"] = shape_json(cfg_.shape);
+    j["shape"] = shape_to_json(cfg_.shape);
     j["time"] = pressure_.measured_time();
     j["collisions"] = ncoll;
     j["wall_seconds"] = wall;
@@ -393,7 +372,7 @@ class Driver {
     }
     if (cfg_.gr_interval > 0.0) write_file_atomic(dir_ + "/gr.tsv", rdf_.to_tsv());
     write_file_atomic(dir_ + "/nematic.tsv", nem_.to_tsv());
-    for (const auto& [k, v] : ops_.extra->items()) j[k] = v;
+    for (const auto& [k, v] : extra_.items()) j[k] = v;
     log.commit();
     write_file_atomic(dir_ + "/summary.json", j.dump(2) + "\n");
     if (!opt_.quiet)
@@ -410,8 +389,9 @@ class Driver {
   std::string dir_;
   Sim& sim_;
   DriverState st_;
-  ShapeSpec shape_;
-  SystemOps ops_;
+  AnyShape shape_;
+  const SystemOps& ops_;
+  nlohmann::json extra_;  // merged into summary.json
   VirialPressure pressure_;
   TimeCorrelations corr_;
   RadialDistribution rdf_;
@@ -424,8 +404,8 @@ class Driver {
 
 template <class Sim>
 void drive(const Config& cfg, const RunOptions& opt, const std::string& dir, Sim& sim,
-           const DriverState& st, const SystemOps& ops) {
-  Driver<Sim> d(cfg, opt, dir, sim, st, cfg.shape, ops);
+           const DriverState& st, const SystemOps& ops, nlohmann::json extra) {
+  Driver<Sim> d(cfg, opt, dir, sim, st, ops, std::move(extra));
   try {
     d.run();
   } catch (const Interrupted& e) {
@@ -452,206 +432,51 @@ void drive(const Config& cfg, const RunOptions& opt, const std::string& dir, Sim
   }
 }
 
-// Starts a new run (make_sim builds the initial system) or resumes from the checkpoint
-// (make_model and nb rebuild the model and the neighbour method around the restored state).
-template <class Sim, class MakeSim, class MakeModel>
-void start_or_resume(const Config& cfg, const RunOptions& opt, const std::string& dir,
-                     MakeSim make_sim, MakeModel make_model, typename Sim::neighbors_type nb,
-                     const SystemOps& ops) {
+// summary.json "init": how the initial bodies were made.
+nlohmann::json init_json(const StartInfo& i) {
+  if (i.method != "grow") return {{"method", i.method}};
+  const GrowthResult& g = i.result;
+  return {{"method", "grow"}, {"phi0", i.growth.phi0}, {"growth_rate", i.growth.rate},
+          {"growth_time", g.time}, {"growth_collisions", g.collisions},
+          {"growth_wall_seconds", g.wall_seconds}, {"growth_velocity_rescales", g.rescales},
+          {"min_distance_after_growth", g.overlaps.min_distance}};
+}
+
+// Starts a new run from the assembly's start, or resumes from the checkpoint.
+template <class A>
+void start_or_resume(const Config& cfg, const RunOptions& opt, const std::string& dir, const A& as) {
   const SignalGuard guard;
   if (opt.resume) {
     const std::string ck = dir + "/checkpoint.gsd";
     if (!file_exists(ck)) throw InputError(fmt::format("{}: no checkpoint to resume from", ck));
-    auto r = read_checkpoint<typename Sim::neighbors_type>(ck, cfg);
-    nb.restore(r.box, r.state, r.neighbors);
-    Sim sim(r.box, std::move(r.state), make_model(), std::move(nb), r.loop);
-    drive(cfg, opt, dir, sim, r.driver, ops);
+    auto r = read_checkpoint<typename A::neighbors_type>(ck, cfg);
+    auto sim = as.restore(r.box, std::move(r.state), r.neighbors, r.loop);
+    const bool grown = !std::holds_alternative<Sphere>(cfg.shape) && cfg.init_method == "grow" &&
+                       cfg.packing_fraction > cfg.init_phi0;
+    drive(cfg, opt, dir, sim, r.driver, as.ops(), {{"init", {{"method", grown ? "grow" : "lattice"}}}});
     return;
   }
-  Sim sim = make_sim();
+  Start start = as.start(StartOptions{opt.quiet});
+  auto sim = as.simulate(start.box, std::move(start.state));
   {
-    const auto rep = ops.overlaps(sim.state(), sim.box());
+    const auto rep = as.ops().overlaps(sim.state(), sim.box());
     if (rep.overlaps > 0)
       throw InputError(fmt::format("{}: the initial configuration has {} overlapping pairs",
                                    cfg.source, rep.overlaps));
   }
   make_directories(dir);
   write_file_atomic(dir + "/config.resolved.toml", to_toml(cfg));
-  drive(cfg, opt, dir, sim, DriverState{}, ops);
+  drive(cfg, opt, dir, sim, DriverState{}, as.ops(), {{"init", init_json(start.info)}});
 }
 
 }  // namespace
-
-// Everything a hard-sphere run needs, checked before any file is written.
-SphereSystemSpec plan_spheres(const Config& c) {
-  SphereSystemSpec p;
-  p.n = c.particles;
-  p.phi = c.packing_fraction;
-  p.sigma = 2.0 * c.shape.radius;
-  p.mass = c.mass;
-  p.kT = c.temperature;
-  p.seed = c.seed;
-  p.shell = c.neighbors_method == "nnl" ? c.shell : 0.0;
-  const Box box = cubic_box_for(c.particles, c.shape.volume(), c.packing_fraction);
-  const double phi_max = fcc_max_packing_fraction(c.particles);
-  if (c.packing_fraction > phi_max * (1.0 - 1e-12))
-    throw ConfigError(fmt::format(
-        "{}: key 'system.packing_fraction': {} is too dense for an FCC start with {} particles "
-        "(at most {:.4f}; use N = 4 m^3 for up to 0.74)",
-        c.source, c.packing_fraction, c.particles, phi_max));
-  const double reach = p.sigma + p.shell;
-  if (box.L.minCoeff() < 2.0 * reach)
-    throw ConfigError(fmt::format(
-        "{}: key 'system.particles': {} particles at packing fraction {} give a box of side "
-        "{:.3g}, less than two interaction ranges ({:.3g}); use more particles",
-        c.source, c.particles, c.packing_fraction, box.L.x(), 2.0 * reach));
-  return p;
-}
-
-namespace {
-
-// The rigid-body plan for a lattice of unit bodies `unit` and bodies of bounding radius
-// `bounding` (plan_ellipsoids, plan_superquadrics).
-RigidSystemSpec plan_rigid(const Config& c, const UnitBody& unit, double bounding) {
-  RigidSystemSpec p;
-  p.n = c.particles;
-  p.phi = c.packing_fraction;
-  p.semi_axes = c.shape.semi_axes;
-  p.exponents = c.shape.exponents;
-  p.mass = c.mass;
-  p.inertia = c.shape.inertia;
-  p.kT = c.temperature;
-  p.seed = c.seed;
-  p.eps_d = c.eps_d;
-  const StretchedLattice lat = stretched_lattice(c.particles, c.shape.semi_axes, unit);
-  const bool grow = c.init_method == "grow" && c.packing_fraction > c.init_phi0;
-  if (grow && c.init_phi0 > lat.phi_max * (1.0 - 1e-12))
-    throw ConfigError(fmt::format("{}: key 'init.phi0': {} is too dense for the lattice start",
-                                  c.source, c.init_phi0));
-  if (!grow && c.packing_fraction > lat.phi_max * (1.0 - 1e-12))
-    throw ConfigError(fmt::format(
-        "{}: key 'system.packing_fraction': {} is too dense for the lattice start with {} "
-        "particles (at most {:.4f})", c.source, c.packing_fraction, c.particles, lat.phi_max));
-  const double a0 = lattice_constant(c.particles, c.packing_fraction, lat.m, unit);
-  const Vec3 L(c.shape.semi_axes.x() * a0 * lat.m[0], c.shape.semi_axes.y() * a0 * lat.m[1],
-               c.shape.semi_axes.z() * a0 * lat.m[2]);
-  const double range = 2.0 * bounding;
-  if (L.minCoeff() < 2.0 * range)
-    throw ConfigError(fmt::format(
-        "{}: key 'system.particles': {} particles at packing fraction {} give a box side of "
-        "{:.3g}, less than two body lengths ({:.3g}); use more particles",
-        c.source, c.particles, c.packing_fraction, L.minCoeff(), 2.0 * range));
-  return p;
-}
-
-RigidSystemSpec plan_superquadrics(const Config& c) {
-  RigidSystemSpec p;
-  p.exponents = c.shape.exponents;
-  p.semi_axes = c.shape.semi_axes;
-  return plan_rigid(c, superquadric_unit_body(p), superquadric_shape(p).bounding_radius());
-}
-
-// A run of rigid bodies of shape S: `model` builds the pair model, `lattice(spec, box)` the
-// lattice start, `grow(options)` the grown start, `overlaps` is the independent check.
-template <Shape S, class Model, class Lattice, class Grow>
-void run_rigid(const Config& cfg, const RunOptions& opt, const std::string& dir,
-               const RigidSystemSpec& spec, Model model, Lattice lattice, Grow grow,
-               std::function<OverlapReport(const State&, const Box&)> overlaps) {
-  const RigidBodies<S> proto = model(spec);
-  const SystemOps ops{[proto](const State& s) { return proto.kinetic_energy(s); },
-                      std::move(overlaps)};
-  // The initial state: the stretched lattice at the target density, or (init.method =
-  // "grow", above init.phi0) a dilute lattice grown Lubachevsky–Stillinger style.
-  const bool grown = cfg.init_method == "grow" && cfg.packing_fraction > cfg.init_phi0;
-  auto start = [&](Box& box) {
-    if (!grown) return lattice(spec, box);
-    GrowthOptions go;
-    go.rate = cfg.init_growth_rate;
-    go.phi0 = cfg.init_phi0;
-    go.kT = cfg.temperature;
-    if (!opt.quiet)
-      std::fprintf(stderr, "hardbody: growing from phi = %g to %g (rate %g) ...\n", go.phi0,
-                   cfg.packing_fraction, go.rate);
-    GrowthResult g = grow(go);
-    (*ops.extra)["init"] = {{"method", "grow"}, {"phi0", go.phi0}, {"growth_rate", go.rate},
-                            {"growth_time", g.time}, {"growth_collisions", g.collisions},
-                            {"growth_wall_seconds", g.wall_seconds},
-                            {"growth_velocity_rescales", g.rescales},
-                            {"min_distance_after_growth", g.overlaps.min_distance}};
-    box = g.box;
-    return std::move(g.state);
-  };
-  if (!grown) (*ops.extra)["init"] = {{"method", "lattice"}};
-  auto make = [&](auto nb) {
-    return [&, nb] {
-      Box box;
-      State st = start(box);
-      return Simulation<RigidBodies<S>, decltype(nb)>(box, std::move(st), model(spec), nb);
-    };
-  };
-  auto remake_model = [&] { return model(spec); };
-  if (cfg.neighbors_method == "nnl") {
-    using Sim = Simulation<RigidBodies<S>, ObbNeighbors<S>>;
-    const ObbNeighbors<S> nb(proto.shape, cfg.shell);
-    start_or_resume<Sim>(cfg, opt, dir, make(nb), remake_model, nb, ops);
-  } else {
-    using Sim = Simulation<RigidBodies<S>, CellNeighbors>;
-    const CellNeighbors nb(proto.interaction_range());
-    start_or_resume<Sim>(cfg, opt, dir, make(nb), remake_model, nb, ops);
-  }
-}
-
-}  // namespace
-
-RigidSystemSpec plan_ellipsoids(const Config& c) {
-  return plan_rigid(c, UnitBody{}, c.shape.semi_axes.maxCoeff());
-}
 
 void run_simulation(const RunOptions& opt) {
   const Config cfg = load_config(opt.config_path, opt.overrides);
   const std::string dir = opt.out_dir.empty() ? default_out_dir(opt.config_path) : opt.out_dir;
   try {
-    // Everything is checked (plan_*) before any file is written.
-    if (cfg.shape.type == "sphere") {
-      const SphereSystemSpec spec = plan_spheres(cfg);
-      const SystemOps ops{[m = spec.mass](const State& s) { return kinetic_energy(s, m); },
-                          [sigma = spec.sigma](const State& s, const Box& b) {
-                            return sphere_overlaps(s.r, b, sigma);
-                          }};
-      auto model = [&] { return HardSpheres{spec.sigma, spec.mass}; };
-      if (spec.shell > 0.0)
-        start_or_resume<SphereListSim>(cfg, opt, dir, [&] { return make_hard_sphere_list_simulation(spec); },
-                                       model, ShellNeighbors(spec.sigma, spec.shell), ops);
-      else
-        start_or_resume<SphereCellSim>(cfg, opt, dir, [&] { return make_hard_sphere_cell_simulation(spec); },
-                                       model, CellNeighbors(spec.sigma), ops);
-    } else if (cfg.shape.type == "ellipsoid") {
-      const RigidSystemSpec spec = plan_ellipsoids(cfg);
-      run_rigid<Ellipsoid>(
-          cfg, opt, dir, spec, ellipsoid_model, ellipsoid_start,
-          [&](const GrowthOptions& go) { return grow_to(spec, go); },
-          [axes = spec.semi_axes](const State& s, const Box& b) {
-            return ellipsoid_overlaps(s.r, s.q, b, axes);
-          });
-    } else if (cfg.shape.type == "superquadric") {
-      // Spherical tops with the ellipsoids' inertia convention (config: 2/5 m r_min^2 unless
-      // shape.inertia is given); the independent check samples the surfaces
-      // (observers/overlap_sampling.hpp), one sampling shared by every check of the run.
-      const RigidSystemSpec spec = plan_superquadrics(cfg);
-      const auto check = std::make_shared<const SurfaceSampling<Superquadric>>(superquadric_shape(spec));
-      auto overlaps = [check](const State& s, const Box& b) {
-        return sampled_overlaps(s.r, s.q, b, *check);
-      };
-      run_rigid<Superquadric>(
-          cfg, opt, dir, spec, superquadric_model, superquadric_start,
-          [&](const GrowthOptions& go) {
-            return grow_lattice(superquadric_shape(spec), spec, go, superquadric_start, overlaps);
-          },
-          overlaps);
-    } else {
-      throw ConfigError(fmt::format("{}: key 'shape.type': '{}' bodies are not yet supported by "
-                                    "`hardbody run`", cfg.source, cfg.shape.type));
-    }
+    // Everything is checked (by the builder) before any file is written.
+    assemble(cfg, [&](const auto& as) { start_or_resume(cfg, opt, dir, as); });
   } catch (const std::filesystem::filesystem_error& e) {
     throw InputError(e.what());
   } catch (const std::invalid_argument& e) {

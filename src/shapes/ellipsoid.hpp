@@ -20,6 +20,7 @@
 namespace hb {
 
 struct Ellipsoid {
+  static constexpr const char* kName = "ellipsoid";
   double a = 1.0, b = 1.0, c = 1.0;
 
   Vec3 inv_sq() const { return Vec3(1.0 / (a * a), 1.0 / (b * b), 1.0 / (c * c)); }
@@ -53,6 +54,7 @@ struct Ellipsoid {
 };
 
 struct Sphere {
+  static constexpr const char* kName = "sphere";
   double radius = 1.0;
 
   double f(const Vec3& x) const { return x.squaredNorm() / (radius * radius) - 1.0; }

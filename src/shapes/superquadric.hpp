@@ -101,6 +101,7 @@ inline double log_root(const Vec3& k, const Vec3& v) {
 // which costs a root solve with logs and exps, and the support function's per-axis constants);
 // treat them as read-only: build a new Superquadric to change a shape.
 struct Superquadric {
+  static constexpr const char* kName = "superquadric";
   double a = 1.0, b = 1.0, c = 1.0;  // semi-axes along body x, y, z
   double n = 2.0, m = 2.0, p = 2.0;  // exponents (>= 2) of |x/a|, |y/b|, |z/c|
 

@@ -11,7 +11,7 @@
 #include "collision/rigid.hpp"
 #include "contact/contact_time.hpp"
 #include "geometry/distance.hpp"
-#include "shapes/describe.hpp"
+#include "shapes/codec.hpp"
 #include "system/box.hpp"
 #include "system/state.hpp"
 

@@ -191,7 +191,7 @@ def test_contact_time_contract(tmp_path):
     ("not json", "malformed JSON"),
     ('{"a": {}}', "a"),
     ('{"a": {"shape": {"type": "cube"}, "position": [0,0,0], "orientation": [1,0,0,0]}, "b": {}}', "unknown shape type 'cube'"),
-    ('{"a": {"shape": {"type": "sphere", "radius": -1}, "position": [0,0,0], "orientation": [1,0,0,0]}, "b": {}}', "radius must be positive"),
+    ('{"a": {"shape": {"type": "sphere", "radius": -1}, "position": [0,0,0], "orientation": [1,0,0,0]}, "b": {}}', "shape: key 'radius': must be positive"),
 ])
 def test_pair_queries_bad_input_exit_2(tmp_path, line, expect):
     r = subprocess.run([HB, "distance"], input=line + "\n", capture_output=True, text=True, cwd=tmp_path)

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "io/config.hpp"
+#include "shapes/codec.hpp"
 
 using namespace hb;
 
@@ -42,8 +43,8 @@ TEST(Config, GoodConfigParsesWithDefaults) {
   EXPECT_EQ(c.particles, 256u);
   EXPECT_DOUBLE_EQ(c.packing_fraction, 0.3);
   EXPECT_EQ(c.seed, 7u);
-  EXPECT_EQ(c.shape.type, "sphere");
-  EXPECT_DOUBLE_EQ(c.shape.radius, 0.5);
+  EXPECT_EQ(shape_name(c.shape), "sphere");
+  EXPECT_DOUBLE_EQ(std::get<Sphere>(c.shape).radius, 0.5);
   EXPECT_DOUBLE_EQ(c.log_interval, 1.0);
   EXPECT_EQ(c.neighbors_method, "cells");
 }
@@ -54,7 +55,7 @@ TEST(Config, ResolvedTomlRoundTrips) {
   EXPECT_EQ(d.particles, c.particles);
   EXPECT_EQ(d.packing_fraction, c.packing_fraction);
   EXPECT_EQ(d.log_interval, 0.25);
-  EXPECT_EQ(d.shape.inertia, c.shape.inertia);
+  EXPECT_EQ(d.inertia, c.inertia);
 }
 
 TEST(Config, OverridesApply) {
@@ -115,4 +116,24 @@ TEST(Config, MissingFileIsAConfigError) {
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/dir/x.toml: cannot open"), std::string::npos);
   }
+}
+
+TEST(Config, ShapeKeysFollowTheShapeType) {
+  const std::string g = kGood;
+  EXPECT_NE(error_of(replace(g, "radius = 0.5", "radius = 0.5\nexponents = [2, 2, 4]"))
+                .find("cfg.toml:9: key 'shape.exponents': does not apply to shape type 'sphere' (its keys: radius)"),
+            std::string::npos);
+  EXPECT_NE(error_of(replace(g, "radius = 0.5", "radius = 0.5\ncolour = 1")).find("unknown key 'shape.colour'"),
+            std::string::npos);
+  const Config sq = parse_config(
+      replace(g, "type = \"sphere\"\nradius = 0.5",
+              "type = \"superquadric\"\nsemi_axes = [1.0, 0.5, 0.5]\nexponents = [2, 2, 8]"),
+      "cfg.toml");
+  ASSERT_TRUE(std::holds_alternative<Superquadric>(sq.shape));
+  EXPECT_EQ(std::get<Superquadric>(sq.shape).p, 8.0);
+  EXPECT_EQ(sq.neighbors_method, "nnl");
+  EXPECT_DOUBLE_EQ(sq.inertia, 0.4 * 0.25);  // 2/5 m r_min^2 by default
+  // the resolved TOML round-trips the shape
+  const Config back = parse_config(to_toml(sq), "resolved.toml");
+  EXPECT_EQ(shape_json(back.shape), shape_json(sq.shape));
 }

@@ -16,7 +16,7 @@
 #include "geometry/random_pairs.hpp"
 #include "neighbors/obb_neighbors.hpp"
 #include "observers/overlap.hpp"
-#include "system/rigid_setup.hpp"
+#include "setup/rigid_setup.hpp"
 
 namespace hb {
 namespace {

@@ -5,7 +5,7 @@
 #include <random>
 
 #include "observers/overlap.hpp"
-#include "system/init.hpp"
+#include "setup/init.hpp"
 
 using namespace hb;
 

@@ -14,7 +14,7 @@
 #include "observers/overlap_sampling.hpp"
 #include "shapes/ellipsoid.hpp"
 #include "shapes/superquadric.hpp"
-#include "system/init.hpp"
+#include "setup/init.hpp"
 
 using namespace hb;
 

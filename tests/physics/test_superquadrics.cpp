@@ -10,7 +10,7 @@
 
 #include "observers/overlap_sampling.hpp"
 #include "physics/run_helper.hpp"
-#include "system/rigid_setup.hpp"
+#include "setup/rigid_setup.hpp"
 
 using hbtest::run_config;
 using namespace hb;

@@ -1,4 +1,4 @@
-// Lubachevsky–Stillinger growth (system/growth.hpp): the growth collision rule, overlap-free
+// Lubachevsky–Stillinger growth (setup/growth.hpp): the growth collision rule, overlap-free
 // growing runs at intermediate times, and grow_to reaching phi = 0.55 for prolate (X0 = 2) and
 // oblate (X0 = 0.5) ellipsoids from a dilute lattice, checked by Perram–Wertheim.
 #include <gtest/gtest.h>
@@ -7,8 +7,8 @@
 
 #include "geometry/random_pairs.hpp"
 #include "observers/overlap.hpp"
-#include "system/growth.hpp"
-#include "system/rigid_setup.hpp"
+#include "setup/growth.hpp"
+#include "setup/rigid_setup.hpp"
 
 namespace hb {
 namespace {

@@ -1,4 +1,4 @@
-#include "system/init.hpp"
+#include "setup/init.hpp"
 
 #include <cmath>
 #include <pcg_random.hpp>

@@ -37,7 +37,7 @@
 #include "observers/overlap.hpp"
 #include "system/box.hpp"
 #include "system/rigid_bodies.hpp"
-#include "system/rigid_setup.hpp"
+#include "setup/rigid_setup.hpp"
 #include "system/simulation.hpp"
 #include "system/state.hpp"
 

@@ -22,7 +22,7 @@
 #include "neighbors/obb_neighbors.hpp"
 #include "shapes/ellipsoid.hpp"
 #include "shapes/superquadric.hpp"
-#include "system/init.hpp"
+#include "setup/init.hpp"
 #include "system/rigid_bodies.hpp"
 #include "system/simulation.hpp"
 

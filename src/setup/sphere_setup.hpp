@@ -6,7 +6,7 @@
 #include "neighbors/cell_neighbors.hpp"
 #include "neighbors/shell_neighbors.hpp"
 #include "system/hard_spheres.hpp"
-#include "system/init.hpp"
+#include "setup/init.hpp"
 #include "system/simulation.hpp"
 
 namespace hb {

@@ -1,0 +1,70 @@
+#include "setup/builder.hpp"
+
+#include <fmt/format.h>
+
+namespace hb {
+
+SphereSystemSpec plan_spheres(const Config& c) {
+  SphereSystemSpec p;
+  p.n = c.particles;
+  p.phi = c.packing_fraction;
+  p.sigma = 2.0 * std::get<Sphere>(c.shape).radius;
+  p.mass = c.mass;
+  p.kT = c.temperature;
+  p.seed = c.seed;
+  p.shell = c.neighbors_method == "nnl" ? c.shell : 0.0;
+  const Box box = cubic_box_for(c.particles, volume(c.shape), c.packing_fraction);
+  const double phi_max = fcc_max_packing_fraction(c.particles);
+  if (c.packing_fraction > phi_max * (1.0 - 1e-12))
+    throw ConfigError(fmt::format(
+        "{}: key 'system.packing_fraction': {} is too dense for an FCC start with {} particles "
+        "(at most {:.4f}; use N = 4 m^3 for up to 0.74)",
+        c.source, c.packing_fraction, c.particles, phi_max));
+  const double reach = p.sigma + p.shell;
+  if (box.L.minCoeff() < 2.0 * reach)
+    throw ConfigError(fmt::format(
+        "{}: key 'system.particles': {} particles at packing fraction {} give a box of side "
+        "{:.3g}, less than two interaction ranges ({:.3g}); use more particles",
+        c.source, c.particles, c.packing_fraction, box.L.x(), 2.0 * reach));
+  return p;
+}
+
+RigidSystemSpec plan_rigid(const Config& c) {
+  RigidSystemSpec p;
+  p.n = c.particles;
+  p.phi = c.packing_fraction;
+  p.semi_axes = half_extents(c.shape);
+  if (const auto* q = std::get_if<Superquadric>(&c.shape)) p.exponents = q->exponents();
+  p.mass = c.mass;
+  p.inertia = c.inertia;
+  p.kT = c.temperature;
+  p.seed = c.seed;
+  p.eps_d = c.eps_d;
+  const UnitBody unit = std::visit(
+      [](const auto& s) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(s)>, Sphere>) return UnitBody{};
+        else return builder_detail::unit_body_of(s);
+      },
+      c.shape);
+  const StretchedLattice lat = stretched_lattice(c.particles, p.semi_axes, unit);
+  const bool grow = c.init_method == "grow" && c.packing_fraction > c.init_phi0;
+  if (grow && c.init_phi0 > lat.phi_max * (1.0 - 1e-12))
+    throw ConfigError(fmt::format("{}: key 'init.phi0': {} is too dense for the lattice start",
+                                  c.source, c.init_phi0));
+  if (!grow && c.packing_fraction > lat.phi_max * (1.0 - 1e-12))
+    throw ConfigError(fmt::format(
+        "{}: key 'system.packing_fraction': {} is too dense for the lattice start with {} "
+        "particles (at most {:.4f})", c.source, c.packing_fraction, c.particles, lat.phi_max));
+  const double a0 = lattice_constant(c.particles, c.packing_fraction, lat.m, unit);
+  const Vec3 L(p.semi_axes.x() * a0 * lat.m[0], p.semi_axes.y() * a0 * lat.m[1],
+               p.semi_axes.z() * a0 * lat.m[2]);
+  const double range = 2.0 * bounding_radius(c.shape);
+  if (L.minCoeff() < 2.0 * range)
+    throw ConfigError(fmt::format(
+        "{}: key 'system.particles': {} particles at packing fraction {} give a box side of "
+        "{:.3g}, less than two body lengths ({:.3g}); use more particles",
+        c.source, c.particles, c.packing_fraction, L.minCoeff(), 2.0 * range));
+  return p;
+}
+
+}  // namespace hb
