@@ -265,11 +265,14 @@ inline hb::Config config_of(const RigidPoint& pt) {
   c.packing_fraction = pt.spec.phi;
   c.seed = pt.spec.seed;
   c.temperature = pt.spec.kT;
-  c.mass = pt.spec.mass;
+  hb::Species& sp = c.species.at(0);
+  sp.count = pt.spec.n;
+  sp.mass = pt.spec.mass;
   const Vec3 a = pt.spec.semi_axes, e = pt.spec.exponents;
-  if (pt.shape == "ellipsoid") c.shape = hb::Ellipsoid{a.x(), a.y(), a.z()};
-  else c.shape = hb::Superquadric{a.x(), a.y(), a.z(), e.x(), e.y(), e.z()};
-  c.inertia = pt.spec.inertia;
+  if (pt.shape == "ellipsoid") sp.shape = hb::Ellipsoid{a.x(), a.y(), a.z()};
+  else sp.shape = hb::Superquadric{a.x(), a.y(), a.z(), e.x(), e.y(), e.z()};
+  sp.name = std::string(hb::shape_name(sp.shape));
+  sp.inertia = Vec3::Constant(pt.spec.inertia);
   c.eps_d = pt.spec.eps_d;
   c.neighbors_method = pt.method;
   c.shell = pt.shell;
@@ -283,7 +286,7 @@ inline hb::Config sphere_config(std::size_t n, double phi, double shell, std::ui
   c.particles = n;
   c.packing_fraction = phi;
   c.seed = seed;
-  c.shape = hb::Sphere{0.5};
+  c.species.at(0) = hb::Species{"sphere", n, hb::Sphere{0.5}, 1.0, Vec3::Constant(0.1), {}};
   c.neighbors_method = shell > 0.0 ? "nnl" : "cells";
   c.shell = shell;
   return c;

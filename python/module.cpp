@@ -19,6 +19,7 @@
 #include "io/config.hpp"
 #include "io/pair_query.hpp"
 #include "io/run.hpp"
+#include "setup/mixture_setup.hpp"
 #include "sim_holder.hpp"
 
 namespace py = pybind11;
@@ -167,7 +168,7 @@ class Simulation {
   double time() const { return sim_->now(); }
   std::uint64_t collisions() const { return sim_->collisions(); }
   py::array_t<double> box() const { return vec3_array(sim_->box().L); }
-  double packing_fraction() const { return double(n()) * volume(cfg_.shape) / sim_->box().volume(); }
+  double packing_fraction() const { return body_volume(cfg_.species, sim_->synchronized()) / sim_->box().volume(); }
   double kinetic_energy() const { return sim_->kinetic_energy(); }
   double temperature() const { return sim_->temperature(); }
   std::uint64_t overlaps() const { return sim_->overlaps().overlaps; }
@@ -199,7 +200,7 @@ class Simulation {
   }
 
   std::string repr() const {
-    return "<hardbody.Simulation " + std::string(shape_name(cfg_.shape)) + " N=" + std::to_string(n()) +
+    return "<hardbody.Simulation " + (cfg_.species.size() == 1 ? std::string(shape_name(cfg_.one().shape)) : std::string("mixture")) + " N=" + std::to_string(n()) +
            " t=" + py::repr(py::float_(time())).cast<std::string>() +
            " collisions=" + std::to_string(collisions()) + ">";
   }

@@ -50,19 +50,29 @@ ConfigSignature config_signature(const Config& c) {
       sig.names.push_back(std::move(name));
       sig.values.push_back(v);
     }
-    void number(std::string_view k, double v) override { add(fmt::format("shape.{}", k), v); }
+    std::string prefix;
+    void number(std::string_view k, double v) override { add(fmt::format("{}{}", prefix, k), v); }
     void triple(std::string_view k, const Vec3& v) override {
-      for (int i = 0; i < 3; ++i) add(fmt::format("shape.{}[{}]", k, i), v[i]);
+      for (int i = 0; i < 3; ++i) add(fmt::format("{}{}[{}]", prefix, k, i), v[i]);
     }
   } w;
   w.add("system.particles", double(c.particles));
   w.add("system.packing_fraction", c.packing_fraction);
   w.add("system.seed", double(c.seed));
   w.add("system.temperature", c.temperature);
-  w.add("system.mass", c.mass);
-  w.add("shape.type", double(c.shape.index()));
-  encode_shape(c.shape, w);
-  w.add("shape.inertia", c.inertia);
+  w.add("species", double(c.species.size()));
+  for (std::size_t k = 0; k < c.species.size(); ++k) {
+    const Species& sp = c.species[k];
+    const std::string p = c.species_given ? fmt::format("species[{}].", k) : "";
+    w.prefix = p + "shape.";
+    w.add(p + "count", double(sp.count));
+    w.add(p + "shape.type", double(sp.shape.index()));
+    encode_shape(sp.shape, w);
+    w.add(p + "mass", sp.mass);
+    for (int i = 0; i < 3; ++i) w.add(fmt::format("{}inertia[{}]", p, i), sp.inertia[i]);
+    w.add(p + "polydispersity.distribution", double(int(sp.poly.distribution)));
+    w.add(p + "polydispersity.width", sp.poly.width);
+  }
   w.add("neighbors.method", c.neighbors_method == "cells" ? 0 : 1);
   w.add("neighbors.shell", c.shell);
   w.add("solver.eps_d", c.eps_d);
@@ -70,7 +80,7 @@ ConfigSignature config_signature(const Config& c) {
 }
 
 void fill_frame(gsd::HoomdFrame& f, const State& s, const Box& box, double now, std::uint64_t step,
-                const AnyShape& shape) {
+                const SpeciesTable& species) {
   const std::size_t n = s.size();
   f.step = step;
   f.N = static_cast<std::uint32_t>(n);
@@ -79,7 +89,8 @@ void fill_frame(gsd::HoomdFrame& f, const State& s, const Box& box, double now, 
   f.orientation.resize(4 * n);
   f.velocity.resize(3 * n);
   f.image.resize(3 * n);
-  f.type_id.assign(n, 0);
+  f.type_id.resize(n);
+  f.diameter.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     for (int k = 0; k < 3; ++k) {
       // HOOMD boxes are centred on the origin; the engine's box is [0, L).
@@ -91,14 +102,21 @@ void fill_frame(gsd::HoomdFrame& f, const State& s, const Box& box, double now, 
     f.orientation[4 * i + 1] = float(s.q[i].x());
     f.orientation[4 * i + 2] = float(s.q[i].y());
     f.orientation[4 * i + 3] = float(s.q[i].z());
+    f.type_id[i] = s.species[i];
+    f.diameter[i] = float(2.0 * bounding_radius(species[s.species[i]].shape) * s.scale[i]);
   }
-  f.types = {std::string(shape_name(shape))};
-  f.type_shapes = {gsd_type_shape(shape)};
+  f.types.clear();
+  f.type_shapes.clear();
+  for (const Species& sp : species) {
+    f.types.push_back(sp.name);
+    f.type_shapes.push_back(gsd_type_shape(sp.shape));
+  }
   // Exact state in the engine's frame [0, L) (box_origin 0), for analysis and conversion.
   f.log[key("position_double")] = vec3s(s.r);
   f.log[key("orientation_double")] = quats(s.q);
   f.log[key("velocity_double")] = vec3s(s.v);
   f.log[key("angular_velocity_double")] = vec3s(s.w);
+  f.log[key("scale")] = scalars(s.scale);
   f.log["hardbody/time"] = row({now});
   f.log["hardbody/box_origin"] = row({0.0, 0.0, 0.0});
   f.log["hardbody/box_double"] = row({box.L.x(), box.L.y(), box.L.z(), 0.0, 0.0, 0.0});
@@ -133,6 +151,7 @@ void add_checkpoint_logs(gsd::HoomdFrame& f, const State& s, const LoopSnapshot&
   f.log["hardbody/obs_correlations"] = row(d.corr);
   f.log["hardbody/obs_gr"] = row(d.gr);
   f.log["hardbody/obs_nematic"] = row(d.nematic);
+  f.log["hardbody/pair_collisions"] = row(d.pair_collisions);
   f.log["hardbody/config"] = row(config_signature(c).values);
 }
 
@@ -212,9 +231,11 @@ void read_core(const Reader& r, Box& box, State& s, LoopSnapshot& loop, DriverSt
   s.t = r.get(key("state_t"), n, 1).values;
   const auto& cnt = r.get(key("state_count"), n, 1).values;
   const auto img = r.vec3s(key("state_image"), n);
+  s.scale = r.get(key("scale"), n, 1).values;
   for (std::size_t i = 0; i < n; ++i) {
     s.count[i] = static_cast<std::uint32_t>(cnt[i]);
     s.image[i] = img[i].cast<int>();
+    s.species[i] = static_cast<std::uint16_t>(r.f.type_id[i]);
   }
   loop.slot = r.events(key("calendar"), n);
   loop.best = r.events(key("best"), n);
@@ -241,6 +262,7 @@ void read_core(const Reader& r, Box& box, State& s, LoopSnapshot& loop, DriverSt
   d.corr = record("hardbody/obs_correlations");
   d.gr = record("hardbody/obs_gr");
   d.nematic = record("hardbody/obs_nematic");
+  d.pair_collisions = record("hardbody/pair_collisions");
 }
 
 void decode(const Reader& r, std::vector<std::array<int, 3>>& out) {
@@ -321,7 +343,9 @@ State state_from_gsd(const std::string& path, long frame, Box& box) {
                : Vec3(f.velocity[3 * i], f.velocity[3 * i + 1], f.velocity[3 * i + 2]);
     if (w) s.w[i] = Vec3((*w)[3 * i], (*w)[3 * i + 1], (*w)[3 * i + 2]);
     s.image[i] = Eigen::Vector3i(f.image[3 * i], f.image[3 * i + 1], f.image[3 * i + 2]);
+    s.species[i] = static_cast<std::uint16_t>(f.type_id[i]);  // checked against the config by the builder
   }
+  if (const auto* sc = exact("scale", 1)) s.scale = *sc;
   return s;
 }
 

@@ -31,6 +31,7 @@ struct DriverState {
   std::vector<double> pressure;            // VirialPressure::save()
   double next_corr = 0.0, next_gr = 0.0;   // next sampling times of the observables
   std::vector<double> corr, gr, nematic;   // their save() records
+  std::vector<double> pair_collisions;     // measured collisions per species pair a <= b (row-major upper triangle)
 };
 
 // A copy of the state with every body streamed to the current time and wrapped into the box.
@@ -57,7 +58,7 @@ struct ConfigSignature {
 };
 ConfigSignature config_signature(const Config& c);
 void fill_frame(gsd::HoomdFrame& f, const State& synced, const Box& box, double now,
-                std::uint64_t step, const AnyShape& shape);
+                std::uint64_t step, const SpeciesTable& species);
 void add_checkpoint_logs(gsd::HoomdFrame& f, const State& s, const LoopSnapshot& loop,
                          const DriverState& d, const Config& c);
 
@@ -83,16 +84,16 @@ gsd::LogArray encode(const ObbSnapshot& c);
 
 // One trajectory frame (synchronised positions) at the simulation's current time.
 template <class Sim>
-gsd::HoomdFrame make_frame(const Sim& sim, const AnyShape& shape, bool, const void*) {
+gsd::HoomdFrame make_frame(const Sim& sim, const SpeciesTable& species, bool, const void*) {
   gsd::HoomdFrame f;
-  ckpt::fill_frame(f, synchronized_state(sim), sim.box(), sim.now(), sim.collisions(), shape);
+  ckpt::fill_frame(f, synchronized_state(sim), sim.box(), sim.now(), sim.collisions(), species);
   return f;
 }
 
 template <class Sim>
-gsd::HoomdFrame make_checkpoint(const Sim& sim, const AnyShape& shape, const Config& c,
+gsd::HoomdFrame make_checkpoint(const Sim& sim, const SpeciesTable& species, const Config& c,
                                 const DriverState& d) {
-  gsd::HoomdFrame f = make_frame(sim, shape, true, nullptr);
+  gsd::HoomdFrame f = make_frame(sim, species, true, nullptr);
   ckpt::add_checkpoint_logs(f, sim.state(), sim.snapshot(), d, c);
   f.log["particles/hardbody/neighbors"] = ckpt::encode(sim.neighbors().snapshot());
   return f;

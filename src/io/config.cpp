@@ -9,6 +9,7 @@
 #include <toml++/toml.h>
 
 #include "shapes/codec.hpp"
+#include "shapes/inertia.hpp"
 
 #include <fmt/format.h>
 
@@ -115,33 +116,36 @@ struct Reader {
       for (int k = 0; k < 3; ++k) out[k] = num(a->get(k), sec + "." + key);
     }
   }
+  Vec3 triple(const toml::node* n, const std::string& key) const {
+    const auto* a = n->as_array();
+    if (!a || a->size() != 3) fail(n, key, "must be an array of 3 numbers");
+    Vec3 out;
+    for (int k = 0; k < 3; ++k) out[k] = num(a->get(k), key);
+    return out;
+  }
   const toml::node* node(const std::string& sec, const std::string& key) const {
     return get(sec, key);
   }
 };
 
-// The [shape] table as the shape codec's parameters; messages name the key and its line.
+// A shape table ([shape], or a species' inline `shape`) as the shape codec's parameters;
+// messages name the key (with `prefix`, e.g. "species[1].shape.") and its line.
 struct TomlShapeParams final : ParamReader {
   const Reader& r;
-  std::string type;
-  TomlShapeParams(const Reader& rr, std::string t) : r(rr), type(std::move(t)) {}
-  bool has(std::string_view key) const override { return r.get("shape", std::string(key)) != nullptr; }
+  const toml::table& t;
+  std::string prefix;
+  TomlShapeParams(const Reader& rr, const toml::table& tt, std::string p) : r(rr), t(tt), prefix(std::move(p)) {}
+  bool has(std::string_view key) const override { return t.get(key) != nullptr; }
   const toml::node* need(std::string_view key) const {
-    const auto* n = r.get("shape", std::string(key));
-    if (!n) throw ConfigError(fmt::format("{}: missing key 'shape.{}'", r.file, key));
+    const auto* n = t.get(key);
+    if (!n) throw ConfigError(fmt::format("{}: missing key '{}{}'", where(r.file, t), prefix, key));
     return n;
   }
-  double number(std::string_view key) const override {
-    return r.num(need(key), "shape." + std::string(key));
-  }
-  Vec3 triple(std::string_view key) const override {
-    Vec3 v;
-    need(key);
-    r.vec3("shape", std::string(key), v);
-    return v;
-  }
+  double number(std::string_view key) const override { return r.num(need(key), prefix + std::string(key)); }
+  Vec3 triple(std::string_view key) const override { return r.triple(need(key), prefix + std::string(key)); }
   [[noreturn]] void fail(std::string_view key, const std::string& what) const override {
-    r.fail(r.get("shape", std::string(key)), "shape." + std::string(key), what);
+    const auto* n = t.get(key);
+    r.fail(n ? n : &t, prefix + std::string(key), what);
   }
 };
 
@@ -157,23 +161,112 @@ toml::table shape_to_toml(const AnyShape& s) {
   return std::move(w.t);
 }
 
-AnyShape read_shape(const Reader& r, const std::string& type) {
-  const TomlShapeParams params(r, type);
-  if (!is_shape_name(type)) params.fail("type", fmt::format("unknown shape type '{}' ({})", type, shape_names()));
-  if (const auto* t = r.root.get_as<toml::table>("shape"))
-    for (const auto& [k, v] : *t) {
-      const std::string key(k.str());
-      if (key != "type" && key != "inertia" && !is_shape_key(type, key))
-        params.fail(key, fmt::format("does not apply to shape type '{}' (its keys: {})", type,
-                                     shape_keys(type)));
+// A shape table: its type and the parameters of the type's codec entry; `extra` keys of the
+// table that are not shape parameters (the shorthand's "inertia").
+AnyShape read_shape(const Reader& r, const toml::table& t, const std::string& prefix,
+                    std::initializer_list<std::string_view> extra = {}) {
+  const TomlShapeParams params(r, t, prefix);
+  const auto* tn = t.get("type");
+  if (!tn) throw ConfigError(fmt::format("{}: missing key '{}type'", where(r.file, t), prefix));
+  const auto type = tn->value_exact<std::string>();
+  if (!type) params.fail("type", "must be a string");
+  if (!is_shape_name(*type)) params.fail("type", fmt::format("unknown shape type '{}' ({})", *type, shape_names()));
+  for (const auto& [k, v] : t) {
+    const std::string key(k.str());
+    if (key == "type" || std::find(extra.begin(), extra.end(), key) != extra.end()) continue;
+    if (!is_shape_key(*type, key))
+      params.fail(key, fmt::format("does not apply to shape type '{}' (its keys: {})", *type, shape_keys(*type)));
+  }
+  return decode_shape(*type, params);
+}
+
+// The mixtures' starts: random placement at init.phi0, then growth. Random sphere packings jam
+// near 0.64; growth at a finite rate stalls before that.
+constexpr double kMixtureStartLimit = 0.6;
+
+// [[species]] -> the species table (DESIGN.md "Species and mixtures"); every problem names
+// species[k].key and its line.
+SpeciesTable read_species(const Reader& r, const toml::array& arr) {
+  SpeciesTable out;
+  if (arr.empty()) r.fail(&arr, "species", "must list at least one species");
+  for (std::size_t k = 0; k < arr.size(); ++k) {
+    const std::string prefix = fmt::format("species[{}].", k);
+    const auto* t = arr.get(k)->as_table();
+    if (!t) r.fail(arr.get(k), "species", "each [[species]] entry must be a table");
+    auto key = [&](const char* name) { return prefix + name; };
+    for (const auto& [kk, vv] : *t) {
+      const std::string name(kk.str());
+      if (name == "sites")
+        r.fail(&vv, key("sites"), "square-well sites are not supported yet");
+      if (name != "name" && name != "count" && name != "shape" && name != "mass" &&
+          name != "inertia" && name != "polydispersity")
+        throw ConfigError(fmt::format("{}: unknown key '{}'", where(r.file, vv), key(name.c_str())));
     }
-  return decode_shape(type, params);
+    Species sp;
+    const auto* name = t->get("name");
+    if (!name) throw ConfigError(fmt::format("{}: missing key '{}'", where(r.file, *t), key("name")));
+    if (auto v = name->value_exact<std::string>()) sp.name = *v;
+    else r.fail(name, key("name"), "must be a string");
+    if (sp.name.empty() || sp.name.find_first_of(" \t\n\"") != std::string::npos)
+      r.fail(name, key("name"), "must be a non-empty word (it is the GSD type name)");
+    for (std::size_t j = 0; j < out.size(); ++j)
+      if (out[j].name == sp.name)
+        r.fail(name, key("name"), fmt::format("duplicate species name '{}' (also species[{}])", sp.name, j));
+    const auto* count = t->get("count");
+    if (!count) throw ConfigError(fmt::format("{}: missing key '{}'", where(r.file, *t), key("count")));
+    const auto n = count->value_exact<int64_t>();
+    if (!n) r.fail(count, key("count"), "must be an integer");
+    if (*n < 1) r.fail(count, key("count"), fmt::format("must be at least 1 (got {})", *n));
+    sp.count = std::uint64_t(*n);
+    const auto* shape = t->get("shape");
+    if (!shape) throw ConfigError(fmt::format("{}: missing key '{}'", where(r.file, *t), key("shape")));
+    if (!shape->as_table()) r.fail(shape, key("shape"), "must be a table, e.g. { type = \"sphere\", radius = 0.5 }");
+    sp.shape = read_shape(r, *shape->as_table(), key("shape."));
+    if (const auto* m = t->get("mass")) {
+      sp.mass = r.num(m, key("mass"));
+      if (!(sp.mass > 0.0)) r.fail(m, key("mass"), fmt::format("must be positive (got {})", sp.mass));
+    }
+    if (const auto* in = t->get("inertia")) {
+      sp.inertia = in->as_array() ? r.triple(in, key("inertia")) : Vec3::Constant(r.num(in, key("inertia")));
+      if (!(sp.inertia.minCoeff() > 0.0))
+        r.fail(in, key("inertia"), "principal moments must be positive (a positive-definite tensor)");
+      const Vec3& I = sp.inertia;
+      if (I.x() + I.y() < I.z() * (1 - 1e-12) || I.y() + I.z() < I.x() * (1 - 1e-12) ||
+          I.x() + I.z() < I.y() * (1 - 1e-12))
+        r.fail(in, key("inertia"), "principal moments of a rigid body satisfy I_a + I_b >= I_c");
+    } else {
+      sp.inertia = uniform_inertia(sp.shape, sp.mass);
+    }
+    if (const auto* pn = t->get("polydispersity")) {
+      const auto* pt = pn->as_table();
+      if (!pt) r.fail(pn, key("polydispersity"), "must be a table { distribution = \"gaussian\", width = 0.1 }");
+      for (const auto& [kk, vv] : *pt)
+        if (kk.str() != "distribution" && kk.str() != "width")
+          throw ConfigError(fmt::format("{}: unknown key '{}.{}'", where(r.file, vv), key("polydispersity"), kk.str()));
+      const auto* d = pt->get("distribution");
+      const std::string dist = d && d->value_exact<std::string>() ? *d->value_exact<std::string>() : "";
+      if (dist == "gaussian") sp.poly.distribution = Polydispersity::Distribution::gaussian;
+      else if (dist == "uniform") sp.poly.distribution = Polydispersity::Distribution::uniform;
+      else r.fail(d ? d : pn, key("polydispersity.distribution"), "must be \"gaussian\" or \"uniform\"");
+      const auto* w = pt->get("width");
+      if (!w) throw ConfigError(fmt::format("{}: missing key '{}'", where(r.file, *pt), key("polydispersity.width")));
+      sp.poly.width = r.num(w, key("polydispersity.width"));
+      if (!(sp.poly.width > 0.0 && sp.poly.width < 0.3))
+        r.fail(w, key("polydispersity.width"), fmt::format("must be in (0, 0.3) (got {})", sp.poly.width));
+    }
+    out.push_back(std::move(sp));
+  }
+  return out;
 }
 
 void check_unknown_keys(const std::string& file, const toml::table& root) {
   const auto& s = schema();
   for (const auto& [k, v] : root) {
     const std::string sec(k.str());
+    if (sec == "species") {
+      if (!v.as_array()) throw ConfigError(fmt::format("{}: 'species' must be an array of tables [[species]]", where(file, v)));
+      continue;  // keys checked by read_species
+    }
     if (sec == "shape") {
       const auto* t = v.as_table();
       if (!t) throw ConfigError(fmt::format("{}: 'shape' must be a table [shape]", where(file, v)));
@@ -228,26 +321,37 @@ Config validate(const std::string& file, const toml::table& root) {
   Reader r{file, root};
   Config c;
   c.source = file;
-  for (const char* sec : {"system", "shape", "run"})
+  const auto* species = root.get_as<toml::array>("species");
+  c.species_given = species != nullptr;
+  for (const char* sec : {"system", "run"})
     if (!root.get_as<toml::table>(sec))
       throw ConfigError(fmt::format("{}: missing section [{}]", file, sec));
+  if (species) {
+    // the [shape] / system.particles / system.mass shorthand is for one species only
+    if (const auto* sh = root.get("shape"))
+      throw ConfigError(fmt::format("{}: [shape] and [[species]] exclude each other (give each species its shape)", where(file, *sh)));
+    for (const char* key : {"particles", "mass"})
+      if (const auto* n = r.get("system", key))
+        r.fail(n, fmt::format("system.{}", key), "is set per species with [[species]] (count, mass)");
+  } else if (!root.get_as<toml::table>("shape")) {
+    throw ConfigError(fmt::format("{}: missing section [shape] (or [[species]])", file));
+  }
   auto require = [&](const char* sec, const char* key) {
     if (!r.get(sec, key))
       throw ConfigError(fmt::format("{}: missing key '{}.{}'", file, sec, key));
   };
-  require("system", "particles");
+  if (!species) require("system", "particles");
   require("system", "packing_fraction");
-  require("shape", "type");
+  if (!species) require("shape", "type");
   require("run", "time");
 
   r.integer("system", "particles", c.particles);
   r.real("system", "packing_fraction", c.packing_fraction);
   r.integer("system", "seed", c.seed);
   r.real("system", "temperature", c.temperature);
-  r.real("system", "mass", c.mass);
-  std::string type;
-  r.string("shape", "type", type);
-  r.real("shape", "inertia", c.inertia);
+  double mass = 1.0, inertia = 0.0;
+  r.real("system", "mass", mass);
+  r.real("shape", "inertia", inertia);
   r.real("run", "equilibrate_time", c.equilibrate_time);
   r.real("run", "time", c.time);
   r.integer("run", "max_collisions", c.max_collisions);
@@ -272,25 +376,45 @@ Config validate(const std::string& file, const toml::table& root) {
   auto bad = [&](const char* sec, const char* key, const std::string& what) {
     r.fail(r.node(sec, key), std::string(sec) + "." + key, what);
   };
-  if (c.particles == 0) bad("system", "particles", "must be at least 1 (got 0)");
+  if (!species && c.particles == 0) bad("system", "particles", "must be at least 1 (got 0)");
   if (c.particles > 100000000) bad("system", "particles", "must be at most 1e8");
   if (!(c.packing_fraction > 0.0)) bad("system", "packing_fraction", "must be positive");
   if (!(c.temperature > 0.0)) bad("system", "temperature", "must be positive");
-  if (!(c.mass > 0.0)) bad("system", "mass", "must be positive");
 
-  c.shape = read_shape(r, type);
-  const PackingLimit lim = packing_limit(c.shape);
-  if (c.packing_fraction >= lim.phi)
-    bad("system", "packing_fraction",
-        fmt::format("{} is not below {} ({})", c.packing_fraction, lim.phi, lim.note));
-  if (r.get("shape", "inertia") && !(c.inertia > 0.0))
-    bad("shape", "inertia", "must be positive");
-  if (c.inertia == 0.0) c.inertia = 0.4 * c.mass * sqr(half_extents(c.shape).minCoeff());
+  if (species) {
+    c.species = read_species(r, *species);
+    c.particles = total_count(c.species);
+    if (c.particles > 100000000) r.fail(species, "species", "the counts must add up to at most 1e8");
+    const bool one_kind = c.species.size() == 1 && !c.species[0].poly.active();
+    const PackingLimit lim = packing_limit(c.species[0].shape);
+    if (one_kind && c.packing_fraction >= lim.phi)
+      bad("system", "packing_fraction", fmt::format("{} is not below {} ({})", c.packing_fraction, lim.phi, lim.note));
+    if (!one_kind && c.packing_fraction > kMixtureStartLimit)
+      bad("system", "packing_fraction",
+          fmt::format("{} is too dense for the start of a mixture (random placement, then growth: at most {})",
+                      c.packing_fraction, kMixtureStartLimit));
+  } else {
+    if (!(mass > 0.0)) bad("system", "mass", "must be positive");
+    Species sp;
+    sp.shape = read_shape(r, *root.get_as<toml::table>("shape"), "shape.", {"inertia"});
+    sp.name = std::string(shape_name(sp.shape));
+    sp.count = c.particles;
+    sp.mass = mass;
+    const PackingLimit lim = packing_limit(sp.shape);
+    if (c.packing_fraction >= lim.phi)
+      bad("system", "packing_fraction",
+          fmt::format("{} is not below {} ({})", c.packing_fraction, lim.phi, lim.note));
+    if (r.get("shape", "inertia") && !(inertia > 0.0)) bad("shape", "inertia", "must be positive");
+    // the paper's convention for the shorthand: a spherical top, I = 2/5 m r_min^2 (ERRATA 8)
+    if (inertia == 0.0) inertia = 0.4 * mass * sqr(half_extents(sp.shape).minCoeff());
+    sp.inertia = Vec3::Constant(inertia);
+    c.species = {sp};
+  }
   if (c.equilibrate_time < 0.0) bad("run", "equilibrate_time", "must not be negative");
   if (!(c.time > 0.0)) bad("run", "time", "must be positive");
   // cells for spheres (their analytic contact times are cheap), neighbour lists otherwise
   if (!r.get("neighbors", "method"))
-    c.neighbors_method = std::holds_alternative<Sphere>(c.shape) ? "cells" : "nnl";
+    c.neighbors_method = std::holds_alternative<Sphere>(c.species[0].shape) ? "cells" : "nnl";
   if (c.neighbors_method != "cells" && c.neighbors_method != "nnl")
     bad("neighbors", "method", fmt::format("must be \"cells\" or \"nnl\" (got \"{}\")", c.neighbors_method));
   if (!(c.shell > 0.0)) bad("neighbors", "shell", "must be positive");
@@ -339,15 +463,10 @@ Config load_config(const std::string& path, const std::vector<std::string>& over
 
 std::string to_toml(const Config& c) {
   auto arr = [](const Vec3& v) { return toml::array{v.x(), v.y(), v.z()}; };
-  toml::table shape = shape_to_toml(c.shape);
-  shape.insert("inertia", c.inertia);
   toml::table root{
-      {"system", toml::table{{"particles", int64_t(c.particles)},
-                             {"packing_fraction", c.packing_fraction},
+      {"system", toml::table{{"packing_fraction", c.packing_fraction},
                              {"seed", int64_t(c.seed)},
-                             {"temperature", c.temperature},
-                             {"mass", c.mass}}},
-      {"shape", shape},
+                             {"temperature", c.temperature}}},
       {"run", toml::table{{"equilibrate_time", c.equilibrate_time},
                           {"time", c.time},
                           {"max_collisions", int64_t(c.max_collisions)}}},
@@ -365,6 +484,27 @@ std::string to_toml(const Config& c) {
                                   {"gr_interval", c.gr_interval},
                                   {"gr_bins", int64_t(c.gr_bins)}}},
   };
+  if (c.species_given) {
+    toml::array all;
+    for (const Species& sp : c.species) {
+      toml::table t{{"name", sp.name}, {"count", int64_t(sp.count)}, {"shape", shape_to_toml(sp.shape)},
+                    {"mass", sp.mass}, {"inertia", toml::array{sp.inertia.x(), sp.inertia.y(), sp.inertia.z()}}};
+      if (sp.poly.active())
+        t.insert("polydispersity",
+                 toml::table{{"distribution", sp.poly.distribution == Polydispersity::Distribution::gaussian
+                                                  ? "gaussian" : "uniform"},
+                             {"width", sp.poly.width}});
+      all.push_back(std::move(t));
+    }
+    root.insert("species", std::move(all));
+  } else {
+    const Species& sp = c.one();
+    root["system"].as_table()->insert("particles", int64_t(c.particles));
+    root["system"].as_table()->insert("mass", sp.mass);
+    toml::table shape = shape_to_toml(sp.shape);
+    shape.insert("inertia", sp.inertia.x());
+    root.insert("shape", std::move(shape));
+  }
   toml::table init;
   init.insert("method", c.init_method);
   init.insert("phi0", c.init_phi0);

@@ -29,6 +29,7 @@ constexpr const char* kN = "particles/N";
 constexpr const char* kTypes = "particles/types";
 constexpr const char* kTypeShapes = "particles/type_shapes";
 constexpr const char* kTypeId = "particles/typeid";
+constexpr const char* kDiameter = "particles/diameter";
 constexpr const char* kPosition = "particles/position";
 constexpr const char* kOrientation = "particles/orientation";
 constexpr const char* kVelocity = "particles/velocity";
@@ -142,8 +143,8 @@ HoomdWriter HoomdWriter::append(const std::filesystem::path& path) {
   if (r.nframes() == 0) return w;
   // Later frames are written against frame 0, so learn what frame 0 holds.
   if (r.has(0, kN)) w.frame0_N_ = r.read<std::uint32_t>(0, kN, 1, 1)[0];
-  for (const char* name : {kDimensions, kTypes, kTypeShapes, kTypeId, kOrientation, kVelocity,
-                           kAngmom, kImage})
+  for (const char* name : {kDimensions, kTypes, kTypeShapes, kTypeId, kDiameter, kOrientation,
+                           kVelocity, kAngmom, kImage})
     if (const Chunk* c = r.find(0, name))
       w.frame0_[name] = EncodedChunk{c->type, c->N, c->M, r.read_bytes(*c)};
   for (const auto& name : r.names_with_prefix(kLogPrefix))
@@ -162,6 +163,7 @@ void HoomdWriter::write_frame(const HoomdFrame& f) {
   check_size(path, "position", f.position.size(), N, 3, false);
   check_size(path, "orientation", f.orientation.size(), N, 4, true);
   check_size(path, "type_id", f.type_id.size(), N, 1, true);
+  check_size(path, "diameter", f.diameter.size(), N, 1, true);
   check_size(path, "velocity", f.velocity.size(), N, 3, true);
   check_size(path, "angmom", f.angmom.size(), N, 4, true);
   check_size(path, "image", f.image.size(), N, 3, true);
@@ -207,6 +209,8 @@ void HoomdWriter::write_frame(const HoomdFrame& f) {
   if (!f.type_id.empty())
     plan.push_back({kTypeId, encode(f.type_id, 1), Fallback::per_particle,
                     repeated<std::uint32_t>(N, {0})});
+  if (!f.diameter.empty())
+    plan.push_back({kDiameter, encode(f.diameter, 1), Fallback::per_particle, repeated<float>(N, {1})});
   if (N > 0) plan.push_back({kPosition, encode(f.position, 3), Fallback::none, {}});
   if (!f.orientation.empty())
     plan.push_back({kOrientation, encode(f.orientation, 4), Fallback::per_particle,
@@ -381,6 +385,7 @@ HoomdFrame read_frame(const Reader& r, std::uint64_t frame) {
     if (id >= f.types.size())
       throw std::runtime_error(fmt::format("{}: frame {}: typeid {} but only {} types", path,
                                            frame, id, f.types.size()));
+  f.diameter = fr.particles<float>(kDiameter, N, N0, {1});
   f.position = fr.particles<float>(kPosition, N, N0, {0, 0, 0});
   f.orientation = fr.particles<float>(kOrientation, N, N0, {1, 0, 0, 0});
   f.velocity = fr.particles<float>(kVelocity, N, N0, {0, 0, 0});

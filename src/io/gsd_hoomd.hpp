@@ -45,6 +45,7 @@ struct HoomdFrame {
   std::vector<std::uint32_t> type_id;     // N (chunk particles/typeid); default 0
   std::vector<std::string> types;         // NT names; default {"A"}
   std::vector<std::string> type_shapes;   // NT JSON objects; empty = none defined
+  std::vector<float> diameter;            // N; default 1 (bounding diameter; OVITO's sphere size)
   std::vector<float> velocity;            // N x 3; default 0
   std::vector<float> angmom;              // N x 4; default 0
   std::vector<std::int32_t> image;        // N x 3; default 0

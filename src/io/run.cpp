@@ -131,13 +131,15 @@ class Driver {
  public:
   Driver(const Config& cfg, const RunOptions& opt, const std::string& dir, Sim& sim,
          const DriverState& st, const SystemOps& ops, nlohmann::json extra)
-      : cfg_(cfg), opt_(opt), dir_(dir), sim_(sim), st_(st), shape_(cfg.shape), ops_(ops),
+      : cfg_(cfg), opt_(opt), dir_(dir), sim_(sim), st_(st), ops_(ops),
         extra_(std::move(extra)),
         corr_(correlation_spec(cfg)), rdf_(rdf_spec(cfg)) {
     if (!st_.pressure.empty()) pressure_.load(st_.pressure);
     if (!st_.corr.empty()) corr_.load(st_.corr);
     if (!st_.gr.empty()) rdf_.load(st_.gr);
     if (!st_.nematic.empty()) nem_.load(st_.nematic);
+    const std::size_t ns = cfg_.species.size();
+    st_.pair_collisions.resize(ns * (ns + 1) / 2, 0.0);
   }
 
   static CorrelationSpec correlation_spec(const Config& c) {
@@ -191,7 +193,7 @@ class Driver {
         wall_mark_ = progress_.wall_seconds();
       }
       if (st_.phase == 1 && writer && sim_.now() >= st_.next_snapshot) {
-        writer->write_frame(make_frame(sim_, shape_, false, nullptr));
+        writer->write_frame(make_frame(sim_, cfg_.species, false, nullptr));
         writer->sync();
         st_.frames += 1;
         st_.next_snapshot += cfg_.snapshot_interval;
@@ -212,6 +214,7 @@ class Driver {
         if (s.type == EventType::None) break;
         if (st_.phase == 1 && s.type == EventType::Collision && !s.stale) {
           pressure_.on_collision(s.record);
+          count_pair(s.record);
           if (cfg_.max_collisions &&
               sim_.collisions() - std::uint64_t(st_.coll0) >= cfg_.max_collisions) {
             limit = true;
@@ -263,7 +266,7 @@ class Driver {
       cpu_mark_ = c;
       wall_mark_ = w;
     }
-    gsd::write_frame_atomic(dir_ + "/checkpoint.gsd", make_checkpoint(sim_, shape_, cfg_, st_));
+    gsd::write_frame_atomic(dir_ + "/checkpoint.gsd", make_checkpoint(sim_, cfg_.species, cfg_, st_));
     last_checkpoint_ = progress_.wall_seconds();
   }
 
@@ -290,17 +293,68 @@ class Driver {
   }
   double energy() const { return ops_.kinetic(sim_.state()); }
   // translational temperature 2 K_trans / (3 N)
-  double temperature() const {
-    return 2.0 * kinetic_energy(sim_.state(), cfg_.mass) / (3.0 * double(sim_.state().size()));
+  double temperature() const { return ops_.temperature(sim_.state()); }
+  // index of the species pair (a <= b) in st_.pair_collisions
+  std::size_t pair_index(std::size_t a, std::size_t b) const {
+    if (a > b) std::swap(a, b);
+    const std::size_t ns = cfg_.species.size();
+    return a * ns - a * (a - 1) / 2 + (b - a);
+  }
+  void count_pair(const CollisionRecord& r) {
+    const State& s = sim_.state();
+    st_.pair_collisions[pair_index(s.species[r.a], s.species[r.b])] += 1.0;
+  }
+  // summary.json "species": per species its resolved mass and inertia and its temperatures;
+  // "species_pairs": measured collision rate of a body of species a with bodies of species b.
+  void species_summary(nlohmann::json& j, const State& st, double measured_time) const {
+    const std::size_t ns = cfg_.species.size();
+    std::vector<double> kt(ns, 0.0), n(ns, 0.0);
+    std::vector<Vec3> kr(ns, Vec3::Zero());
+    for (std::size_t i = 0; i < st.size(); ++i) {
+      const std::size_t a = st.species[i];
+      const double sc = st.scale[i];
+      n[a] += 1.0;
+      kt[a] += ops_.body_mass(st, i) * st.v[i].squaredNorm();
+      const Vec3 wb = st.q[i].conjugate() * st.w[i];  // body-frame angular velocity
+      kr[a] += (cfg_.species[a].inertia * std::pow(sc, 5)).cwiseProduct(wb.cwiseProduct(wb));
+    }
+    nlohmann::json list = nlohmann::json::array();
+    for (std::size_t a = 0; a < ns; ++a) {
+      const Species& sp = cfg_.species[a];
+      nlohmann::json o;
+      o["name"] = sp.name;
+      o["count"] = sp.count;
+      o["mass"] = sp.mass;
+      o["inertia"] = {sp.inertia.x(), sp.inertia.y(), sp.inertia.z()};
+      o["temperature_translational"] = kt[a] / (3.0 * n[a]);
+      if (std::holds_alternative<Sphere>(sp.shape)) {  // smooth spheres never exchange spin
+        o["temperature_rotational"] = nullptr;
+        o["temperature_rotational_axes"] = nullptr;
+      } else {
+        o["temperature_rotational"] = kr[a].sum() / (3.0 * n[a]);
+        o["temperature_rotational_axes"] = {kr[a].x() / n[a], kr[a].y() / n[a], kr[a].z() / n[a]};
+      }
+      if (sp.poly.active()) o["polydispersity"] = {{"width", sp.poly.width}};
+      list.push_back(o);
+    }
+    j["species"] = list;
+    nlohmann::json pairs = nlohmann::json::array();
+    for (std::size_t a = 0; a < ns; ++a)
+      for (std::size_t b = 0; b < ns; ++b) {
+        // each a-b collision involves one body of a and one of b (two of a when a == b)
+        const double c = st_.pair_collisions[pair_index(a, b)] * (a == b ? 2.0 : 1.0);
+        pairs.push_back({{"a", cfg_.species[a].name}, {"b", cfg_.species[b].name}, {"collisions", st_.pair_collisions[pair_index(a, b)]},
+                         {"collision_rate", measured_time > 0.0 ? c / (n[a] * measured_time) : 0.0}});
+      }
+    j["species_pairs"] = pairs;
   }
 
   void finish(LogTable& log) {
     const State st = synchronized_state(sim_);
     const std::uint64_t n = st.size();
     const double e1 = ops_.kinetic(st);
-    const Vec3 p = total_momentum(st, cfg_.mass);
-    double p_scale = 0.0;
-    for (const auto& v : st.v) p_scale += cfg_.mass * v.norm();
+    const Vec3 p = ops_.momentum(st);
+    const double p_scale = ops_.momentum_scale(st);
     const auto rep = ops_.overlaps(st, sim_.box());
     const std::uint64_t ncoll = sim_.collisions() - std::uint64_t(st_.coll0);
     const auto Z = pressure_.Z();
@@ -309,9 +363,14 @@ class Driver {
 
     nlohmann::json j;
     j["particles"] = n;
-    j["packing_fraction"] = double(n) * volume(cfg_.shape) / sim_.box().volume();
+    j["packing_fraction"] = body_volume(cfg_.species, st) / sim_.box().volume();
     j["box"] = {sim_.box().L.x(), sim_.box().L.y(), sim_.box().L.z()};
-    j["shape"] = shape_to_json(cfg_.shape);
+    if (cfg_.species.size() == 1) {
+      j["shape"] = shape_to_json(cfg_.one().shape);
+    } else {
+      j["shape"] = nlohmann::json::array();
+      for (const Species& sp : cfg_.species) j["shape"].push_back(shape_to_json(sp.shape));
+    }
     j["time"] = pressure_.measured_time();
     j["collisions"] = ncoll;
     j["wall_seconds"] = wall;
@@ -323,7 +382,8 @@ class Driver {
     j["Z_blocks"] = Z.blocks;
     j["collision_rate"] = rate.mean;
     j["collision_rate_error"] = rate.error;
-    j["temperature"] = 2.0 * kinetic_energy(st, cfg_.mass) / (3.0 * double(n));
+    j["temperature"] = ops_.temperature(st);
+    species_summary(j, st, pressure_.measured_time());
     j["energy_drift"] = (e1 - st_.e0) / st_.e0;
     j["total_momentum"] = {p.x(), p.y(), p.z()};
     j["momentum_drift"] = p.norm() / p_scale;
@@ -389,7 +449,6 @@ class Driver {
   std::string dir_;
   Sim& sim_;
   DriverState st_;
-  AnyShape shape_;
   const SystemOps& ops_;
   nlohmann::json extra_;  // merged into summary.json
   VirialPressure pressure_;
@@ -451,8 +510,8 @@ void start_or_resume(const Config& cfg, const RunOptions& opt, const std::string
     if (!file_exists(ck)) throw InputError(fmt::format("{}: no checkpoint to resume from", ck));
     auto r = read_checkpoint<typename A::neighbors_type>(ck, cfg);
     auto sim = as.restore(r.box, std::move(r.state), r.neighbors, r.loop);
-    const bool grown = !std::holds_alternative<Sphere>(cfg.shape) && cfg.init_method == "grow" &&
-                       cfg.packing_fraction > cfg.init_phi0;
+    const bool grown = cfg.mixture() || (!std::holds_alternative<Sphere>(cfg.one().shape) &&
+                                         cfg.init_method == "grow" && cfg.packing_fraction > cfg.init_phi0);
     drive(cfg, opt, dir, sim, r.driver, as.ops(), {{"init", {{"method", grown ? "grow" : "lattice"}}}});
     return;
   }

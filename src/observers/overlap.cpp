@@ -1,5 +1,6 @@
 #include "observers/overlap.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "geometry/perram_wertheim.hpp"
@@ -98,6 +99,25 @@ OverlapReport sphere_overlaps(const std::vector<Vec3>& r, const Box& box, double
                               double tol) {
   return r.size() <= 20000 ? sphere_overlaps_brute(r, box, sigma, tol)
                            : sphere_overlaps_grid(r, box, sigma, tol);
+}
+
+}  // namespace hb
+
+namespace hb {
+
+OverlapReport sphere_mixture_overlaps(const std::vector<Vec3>& r, const std::vector<double>& radii,
+                                      const Box& box, double tol) {
+  OverlapReport rep;
+  double rmax = 0.0;
+  for (double x : radii) rmax = std::max(rmax, x);
+  for_close_pairs(r, box, 2.0 * rmax, [&](std::uint32_t i, std::uint32_t j, const Vec3& d) {
+    const double sigma = radii[i] + radii[j];
+    const double dist = d.norm();
+    ++rep.pairs_checked;
+    rep.min_distance = std::min(rep.min_distance, dist - sigma);
+    if (dist < sigma * (1.0 - tol)) ++rep.overlaps;
+  });
+  return rep;
 }
 
 }  // namespace hb

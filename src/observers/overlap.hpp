@@ -26,6 +26,11 @@ OverlapReport sphere_overlaps_grid(const std::vector<Vec3>& r, const Box& box, d
 OverlapReport sphere_overlaps(const std::vector<Vec3>& r, const Box& box, double sigma,
                               double tol = 1e-10);
 
+// Spheres of unequal radii (mixtures, polydispersity): overlap when |r_ij| < (R_i + R_j)(1 - tol);
+// min_distance is the smallest surface gap |r_ij| - R_i - R_j. Candidates from a fresh grid.
+OverlapReport sphere_mixture_overlaps(const std::vector<Vec3>& r, const std::vector<double>& radii,
+                                      const Box& box, double tol = 1e-10);
+
 // Ellipsoids (all with the same semi-axes, orientations body -> lab): the Perram–Wertheim
 // contact function F (geometry/perram_wertheim, independent of the distance solver) for every
 // pair whose centres are closer than the bounding diameter; overlap when F < 1 - tol.

@@ -8,12 +8,12 @@ SphereSystemSpec plan_spheres(const Config& c) {
   SphereSystemSpec p;
   p.n = c.particles;
   p.phi = c.packing_fraction;
-  p.sigma = 2.0 * std::get<Sphere>(c.shape).radius;
-  p.mass = c.mass;
+  p.sigma = 2.0 * std::get<Sphere>(c.one().shape).radius;
+  p.mass = c.one().mass;
   p.kT = c.temperature;
   p.seed = c.seed;
   p.shell = c.neighbors_method == "nnl" ? c.shell : 0.0;
-  const Box box = cubic_box_for(c.particles, volume(c.shape), c.packing_fraction);
+  const Box box = cubic_box_for(c.particles, volume(c.one().shape), c.packing_fraction);
   const double phi_max = fcc_max_packing_fraction(c.particles);
   if (c.packing_fraction > phi_max * (1.0 - 1e-12))
     throw ConfigError(fmt::format(
@@ -29,14 +29,40 @@ SphereSystemSpec plan_spheres(const Config& c) {
   return p;
 }
 
+HardSphereMixture plan_sphere_mixture(const Config& c) {
+  if (c.neighbors_method != "cells")
+    throw ConfigError(fmt::format("{}: key 'neighbors.method': sphere mixtures and polydisperse spheres "
+                                  "use cell lists (\"cells\"); shell lists need one diameter", c.source));
+  HardSphereMixture m = HardSphereMixture::of(c.species);
+  // the box (of the mean volume) must hold two interaction ranges
+  double v = 0.0;
+  for (const Species& sp : c.species) v += double(sp.count) * volume(sp.shape);
+  const double L = std::cbrt(v / c.packing_fraction);
+  if (L < 2.0 * m.interaction_range())
+    throw ConfigError(fmt::format(
+        "{}: key 'species': {} bodies at packing fraction {} give a box of side {:.3g}, less than "
+        "two interaction ranges ({:.3g}); use more bodies", c.source, c.particles, c.packing_fraction,
+        L, 2.0 * m.interaction_range()));
+  return m;
+}
+
 RigidSystemSpec plan_rigid(const Config& c) {
+  if (c.mixture())
+    throw ConfigError(fmt::format("{}: key 'species': mixtures and polydispersity of non-spherical "
+                                  "bodies are not supported yet (spheres only)", c.source));
+  const Species& sp = c.one();
+  if (!sp.spherical_top())
+    throw ConfigError(fmt::format(
+        "{}: key '{}inertia': the principal moments ({:.6g}, {:.6g}, {:.6g}) make a symmetric or "
+        "asymmetric top; only spherical tops (inertia = one number) are supported yet",
+        c.source, c.species_given ? "species[0]." : "shape.", sp.inertia.x(), sp.inertia.y(), sp.inertia.z()));
   RigidSystemSpec p;
   p.n = c.particles;
   p.phi = c.packing_fraction;
-  p.semi_axes = half_extents(c.shape);
-  if (const auto* q = std::get_if<Superquadric>(&c.shape)) p.exponents = q->exponents();
-  p.mass = c.mass;
-  p.inertia = c.inertia;
+  p.semi_axes = half_extents(sp.shape);
+  if (const auto* q = std::get_if<Superquadric>(&sp.shape)) p.exponents = q->exponents();
+  p.mass = sp.mass;
+  p.inertia = sp.inertia.x();
   p.kT = c.temperature;
   p.seed = c.seed;
   p.eps_d = c.eps_d;
@@ -45,7 +71,7 @@ RigidSystemSpec plan_rigid(const Config& c) {
         if constexpr (std::is_same_v<std::decay_t<decltype(s)>, Sphere>) return UnitBody{};
         else return builder_detail::unit_body_of(s);
       },
-      c.shape);
+      sp.shape);
   const StretchedLattice lat = stretched_lattice(c.particles, p.semi_axes, unit);
   const bool grow = c.init_method == "grow" && c.packing_fraction > c.init_phi0;
   if (grow && c.init_phi0 > lat.phi_max * (1.0 - 1e-12))
@@ -58,7 +84,7 @@ RigidSystemSpec plan_rigid(const Config& c) {
   const double a0 = lattice_constant(c.particles, c.packing_fraction, lat.m, unit);
   const Vec3 L(p.semi_axes.x() * a0 * lat.m[0], p.semi_axes.y() * a0 * lat.m[1],
                p.semi_axes.z() * a0 * lat.m[2]);
-  const double range = 2.0 * bounding_radius(c.shape);
+  const double range = 2.0 * bounding_radius(sp.shape);
   if (L.minCoeff() < 2.0 * range)
     throw ConfigError(fmt::format(
         "{}: key 'system.particles': {} particles at packing fraction {} give a box side of "

@@ -13,9 +13,12 @@
 //   restore(box, state, neighbour snapshot, loop snapshot)
 //                            the simulation a checkpoint describes, continued bit for bit
 //   ops()                    kinetic energy, temperature and the independent overlap check
-// One-species hard spheres take the analytic fast path (HardSpheres); every other shape the
-// generic rigid-body model of its registry type.
+// One-species hard spheres take the analytic fast path (HardSpheres), sphere mixtures and
+// polydisperse spheres HardSphereMixture (cell lists, a grown random start); every other shape
+// the generic rigid-body model of its registry type (one species, spherical tops, so far).
 #pragma once
+#include <fmt/format.h>
+
 #include <cstdio>
 #include <functional>
 #include <string>
@@ -29,8 +32,10 @@
 #include "setup/config.hpp"
 #include "setup/growth.hpp"
 #include "setup/init.hpp"
+#include "setup/mixture_setup.hpp"
 #include "setup/rigid_setup.hpp"
 #include "setup/sphere_setup.hpp"
+#include "system/hard_sphere_mixture.hpp"
 #include "system/hard_spheres.hpp"
 #include "system/rigid_bodies.hpp"
 #include "system/simulation.hpp"
@@ -39,14 +44,38 @@ namespace hb {
 
 // What a driver needs to know about the bodies beyond the event loop.
 struct SystemOps {
-  double mass = 1.0;
+  std::vector<double> species_mass;             // per species, at scale 1
   std::function<double(const State&)> kinetic;  // total kinetic energy (translation + rotation)
   OverlapCheck overlaps;                        // independent check of a synchronized state
+
+  double body_mass(const State& s, std::size_t i) const {
+    return species_mass[s.species[i]] * s.scale[i] * s.scale[i] * s.scale[i];
+  }
+  double translational_kinetic(const State& s) const {
+    double k = 0.0;
+    for (std::size_t i = 0; i < s.size(); ++i) k += body_mass(s, i) * s.v[i].squaredNorm();
+    return 0.5 * k;
+  }
   // translational temperature 2 K_trans / (3 N)
-  double temperature(const State& s) const {
-    return 2.0 * kinetic_energy(s, mass) / (3.0 * double(s.size()));
+  double temperature(const State& s) const { return 2.0 * translational_kinetic(s) / (3.0 * double(s.size())); }
+  Vec3 momentum(const State& s) const {
+    Vec3 p = Vec3::Zero();
+    for (std::size_t i = 0; i < s.size(); ++i) p += body_mass(s, i) * s.v[i];
+    return p;
+  }
+  double momentum_scale(const State& s) const {  // sum of |p_i|: the scale of the total's rounding
+    double p = 0.0;
+    for (std::size_t i = 0; i < s.size(); ++i) p += body_mass(s, i) * s.v[i].norm();
+    return p;
   }
 };
+
+// Masses of the species at scale 1.
+inline std::vector<double> species_masses(const SpeciesTable& t) {
+  std::vector<double> m;
+  for (const Species& s : t) m.push_back(s.mass);
+  return m;
+}
 
 // How the initial bodies were made (summary.json "init").
 struct StartInfo {
@@ -64,8 +93,9 @@ struct StartOptions {
 };
 
 // The geometry checks (ConfigError naming the key) and the specifications of the starts.
-SphereSystemSpec plan_spheres(const Config& c);
-RigidSystemSpec plan_rigid(const Config& c);
+SphereSystemSpec plan_spheres(const Config& c);        // one species of spheres
+HardSphereMixture plan_sphere_mixture(const Config& c);  // several species or polydisperse spheres
+RigidSystemSpec plan_rigid(const Config& c);           // one species of non-spherical bodies
 
 template <class Model, class Neighbors>
 class Assembly {
@@ -100,10 +130,42 @@ class Assembly {
 namespace builder_detail {
 
 template <class F>
-void assemble_spheres(const Config& c, const Sphere&, F&& f) {
+void assemble_spheres(const Config& c, F&& f) {
+  if (c.mixture()) {
+    const HardSphereMixture model = plan_sphere_mixture(c);
+    SystemOps ops{species_masses(c.species), [model](const State& s) { return model.kinetic_energy(s); },
+                  [model](const State& s, const Box& b) {
+                    std::vector<double> radii(s.size());
+                    for (std::size_t i = 0; i < s.size(); ++i) radii[i] = model.body_radius(s, i);
+                    return sphere_mixture_overlaps(s.r, radii, b);
+                  }};
+    GrowthOptions go;
+    go.rate = c.init_growth_rate;
+    go.phi0 = std::min(c.init_phi0, c.packing_fraction);
+    go.kT = c.temperature;
+    auto start = [species = c.species, phi = c.packing_fraction, seed = c.seed, go,
+                  check = ops.overlaps](const StartOptions& opt) {
+      if (!opt.quiet)
+        std::fprintf(stderr, "hardbody: placing at phi = %g, growing to %g (rate %g) ...\n", go.phi0, phi, go.rate);
+      Start s;
+      s.info.method = "grow";
+      s.info.growth = go;
+      s.info.result = grow_sphere_mixture(species, phi, seed, go);
+      s.info.result.overlaps = check(s.info.result.state, s.info.result.box);
+      if (s.info.result.overlaps.overlaps != 0)
+        throw std::runtime_error(fmt::format("sphere mixture growth: {} overlapping pairs (seed {})",
+                                             s.info.result.overlaps.overlaps, seed));
+      s.box = s.info.result.box;
+      s.state = std::move(s.info.result.state);
+      return s;
+    };
+    f(Assembly<HardSphereMixture, CellNeighbors>(model, CellNeighbors(model.interaction_range()), ops, start));
+    return;
+  }
+  // one species: the monomorphic fast path
   const SphereSystemSpec spec = plan_spheres(c);
-  SystemOps ops{spec.mass, [m = spec.mass](const State& s) { return kinetic_energy(s, m); },
-                independent_overlap_check(c.shape)};
+  SystemOps ops{species_masses(c.species), [m = spec.mass](const State& s) { return kinetic_energy(s, m); },
+                independent_overlap_check(c.one().shape)};
   auto start = [spec](const StartOptions&) {
     Start s;
     s.state = hard_sphere_start(spec, s.box);
@@ -124,10 +186,10 @@ inline UnitBody unit_body_of(const Superquadric& q) {
 
 template <Shape S, class F>
 void assemble_rigid(const Config& c, const S& shape, F&& f) {
-  const RigidSystemSpec spec = plan_rigid(c);
+  const RigidSystemSpec spec = plan_rigid(c);  // one species, a spherical top
   const RigidBodies<S> model{shape, MassProperties::spherical_top(spec.mass, spec.inertia), spec.eps_d};
-  SystemOps ops{spec.mass, [model](const State& s) { return model.kinetic_energy(s); },
-                independent_overlap_check(c.shape)};
+  SystemOps ops{species_masses(c.species), [model](const State& s) { return model.kinetic_energy(s); },
+                independent_overlap_check(c.one().shape)};
   const UnitBody unit = unit_body_of(shape);
   auto lattice = [unit](const RigidSystemSpec& sp, Box& box) { return lattice_start(sp, unit, box); };
   const bool grow = c.init_method == "grow" && c.packing_fraction > c.init_phi0;
@@ -161,15 +223,15 @@ void assemble_rigid(const Config& c, const S& shape, F&& f) {
 // Calls f(assembly) with the typed Assembly of the config (see the header).
 template <class F>
 void assemble(const Config& c, F&& f) {
+  bool spheres = true;
+  for (const Species& sp : c.species) spheres = spheres && std::holds_alternative<Sphere>(sp.shape);
+  if (spheres) return builder_detail::assemble_spheres(c, f);
   std::visit(
       [&](const auto& shape) {
-        using S = std::decay_t<decltype(shape)>;
-        if constexpr (std::is_same_v<S, Sphere>)
-          builder_detail::assemble_spheres(c, shape, f);
-        else
+        if constexpr (!std::is_same_v<std::decay_t<decltype(shape)>, Sphere>)
           builder_detail::assemble_rigid(c, shape, f);
       },
-      c.shape);
+      c.one().shape);
 }
 
 }  // namespace hb

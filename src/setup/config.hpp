@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "math/types.hpp"
+#include "core/species.hpp"
 #include "shapes/registry.hpp"
 
 namespace hb {
@@ -20,14 +21,18 @@ class ConfigError : public std::runtime_error {
 struct Config {
   std::string source;  // file the config was read from
   // [system]
-  std::uint64_t particles = 0;
+  std::uint64_t particles = 0;  // N: the total over the species
   double packing_fraction = 0.0;
   std::uint64_t seed = 1;
   double temperature = 1.0;
-  double mass = 1.0;
-  // [shape]  (type and the parameters of its ShapeCodec entry, shapes/codec.hpp)
-  AnyShape shape = Sphere{0.5};
-  double inertia = 0.0;  // shape.inertia: scalar moment of inertia; resolved: 2/5 m r_min^2 if not given
+  // [[species]], or the one-species shorthand [shape] + system.particles + system.mass (+
+  // shape.inertia: a spherical top, default 2/5 m r_min^2), resolved into one species named
+  // after the shape type
+  SpeciesTable species{Species{}};
+  bool species_given = false;  // written back as [[species]] (else as the shorthand)
+
+  const Species& one() const { return species.front(); }  // the species of a one-species run
+  bool mixture() const { return species.size() > 1 || species.front().poly.active(); }
   // [run]
   double equilibrate_time = 0.0;
   double time = 0.0;

@@ -32,6 +32,7 @@
 
 #include "collision/rigid.hpp"
 #include "contact/contact_time.hpp"
+#include "motion/growth_law.hpp"
 #include "geometry/distance.hpp"
 #include "neighbors/cell_neighbors.hpp"
 #include "observers/overlap.hpp"
@@ -42,18 +43,6 @@
 #include "system/state.hpp"
 
 namespace hb {
-
-// s(t) = s0 + rate (min(t, t_stop) - t0): linear growth until t_stop, constant afterwards.
-struct GrowthLaw {
-  double s0 = 1.0;
-  double rate = 0.0;  // ds/dt (>= 0)
-  double t0 = 0.0;
-  double t_stop = kInf;
-
-  double scale_at(double t) const { return s0 + rate * (std::min(t, t_stop) - t0); }
-  double rate_at(double t) const { return t < t_stop ? rate : 0.0; }
-  double final_scale() const { return t_stop == kInf ? kInf : scale_at(t_stop); }
-};
 
 template <Shape S>
 struct GrowingRigidBodies {
@@ -167,14 +156,16 @@ struct GrowthResult {
   SolverStats stats;
 };
 
-// Grow bodies of shape `shape` (given at its target size) from `st` (overlap-free at scale s0,
-// positions in `box`) to scale 1 at growth rate opt.rate, rescaling the velocities to opt.kT
-// every opt.rescale_interval.  The state's time stamps are taken as the start time 0.  The
-// result holds the synchronized state at the end of the growth, time stamps reset to 0
-// (no overlap check here: see grow_to).
-template <Shape S>
-GrowthResult grow_bodies(const S& shape, const MassProperties& mass, State st, const Box& box,
-                         double s0, const GrowthOptions& opt, double eps_d = 1e-5) {
+// The growth loop shared by every pair model with a growth law (`model.law` from s0 at t = 0 to
+// 1 at t_stop): runs the event loop with cell lists in stretches of opt.rescale_interval,
+// streams every body to the end of each stretch and calls rescale(state) (the thermostat; it
+// returns the kinetic energy removed), then continues with a fresh prediction. The state's time
+// stamps are taken as the start time 0; the result holds the synchronized state at t_stop, time
+// stamps reset to 0 (no overlap check here).
+template <class Model, class Rescale>
+GrowthResult run_growth(Model model, State st, const Box& box, const GrowthOptions& opt,
+                        Rescale rescale) {
+  const double s0 = model.law.s0, t_stop = model.law.t_stop;
   if (!(s0 > 0.0 && s0 <= 1.0)) throw std::invalid_argument("grow_bodies: need 0 < s0 <= 1");
   if (!(opt.rate > 0.0) || !std::isfinite(opt.rate))
     throw std::invalid_argument("grow_bodies: the growth rate must be > 0");
@@ -184,14 +175,12 @@ GrowthResult grow_bodies(const S& shape, const MassProperties& mass, State st, c
   GrowthResult res;
   res.box = box;
   res.s0 = s0;
-  const double t_stop = (1.0 - s0) / opt.rate;
-  GrowingRigidBodies<S> model{shape, mass, GrowthLaw{s0, opt.rate, 0.0, t_stop}, eps_d};
   for (std::size_t i = 0; i < st.size(); ++i) st.t[i] = 0.0;
-  rescale_to_temperature(st, mass, opt.kT);
+  rescale(st);
   double t = 0.0;
   while (t < t_stop) {
     const double t_next = std::min(t + opt.rescale_interval, t_stop);
-    using Sim = Simulation<GrowingRigidBodies<S>, CellNeighbors>;
+    using Sim = Simulation<Model, CellNeighbors>;
     const double range = model.interaction_range();
     Sim sim(box, std::move(st), std::move(model), CellNeighbors(range), t);
     while (sim.step(t_next).type != EventType::None) {
@@ -201,18 +190,32 @@ GrowthResult grow_bodies(const S& shape, const MassProperties& mass, State st, c
     st = sim.state();
     model = sim.model();
     t = t_next;
-    const double k_before = model.kinetic_energy(st);
-    rescale_to_temperature(st, mass, opt.kT);
-    res.heat_removed += k_before - model.kinetic_energy(st);
+    res.heat_removed += rescale(st);
     ++res.rescales;
   }
   res.time = t;
-  res.stats = model.stats;
+  if constexpr (requires { model.stats; }) res.stats = model.stats;
   for (std::size_t i = 0; i < st.size(); ++i) st.t[i] = 0.0;  // time 0 of the continuing run
   res.state = std::move(st);
-  res.phi = double(res.state.size()) * shape.volume() / box.volume();
   res.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t_wall).count();
+  return res;
+}
+
+// Grow bodies of shape `shape` (given at its target size) from `st` (overlap-free at scale s0,
+// positions in `box`) to scale 1 at growth rate opt.rate, rescaling the velocities to opt.kT
+// every opt.rescale_interval (run_growth).
+template <Shape S>
+GrowthResult grow_bodies(const S& shape, const MassProperties& mass, State st, const Box& box,
+                         double s0, const GrowthOptions& opt, double eps_d = 1e-5) {
+  const double t_stop = (1.0 - s0) / opt.rate;
+  GrowingRigidBodies<S> model{shape, mass, GrowthLaw{s0, opt.rate, 0.0, t_stop}, eps_d};
+  GrowthResult res = run_growth(std::move(model), std::move(st), box, opt, [&](State& x) {
+    const double k = total_kinetic_energy(x, mass);
+    rescale_to_temperature(x, mass, opt.kT);
+    return k - total_kinetic_energy(x, mass);
+  });
+  res.phi = double(res.state.size()) * shape.volume() / box.volume();
   return res;
 }
 

@@ -17,6 +17,8 @@ struct State {
   std::vector<double> t;              // time stamp of the stored state
   std::vector<std::uint32_t> count;   // number of velocity changes (event counter)
   std::vector<Eigen::Vector3i> image; // periodic images crossed (for unwrapped positions)
+  std::vector<std::uint16_t> species; // index into the run's species table (core/species.hpp)
+  std::vector<double> scale;          // size scale of the body (1 unless polydisperse)
 
   std::size_t size() const { return r.size(); }
   void resize(std::size_t n) {
@@ -27,6 +29,8 @@ struct State {
     t.assign(n, 0.0);
     count.assign(n, 0);
     image.assign(n, Eigen::Vector3i::Zero());
+    species.assign(n, 0);
+    scale.assign(n, 1.0);
   }
 
   // Position of body i at time `now` (no state change).

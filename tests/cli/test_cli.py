@@ -5,6 +5,7 @@ import os
 import subprocess
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 HB = os.environ.get("HARDBODY", "hardbody")
@@ -238,17 +239,18 @@ def test_run_accepts_superquadrics(tmp_path, method):
         assert abs(abs(x / 1.0) ** 4 + abs(y / 0.5) ** 4 + abs(z / 0.5) ** 4 - 1.0) < 1e-9
 
 
-def test_superquadric_resume_reproduces_uninterrupted_run(tmp_path):
+def assert_resume_reproduces(tmp_path, cfg_text, delay, keys):
+    """Run to the end; run again, SIGTERM after `delay` s, --resume: same summary keys and log."""
     import signal
     import time
 
-    cfg = tmp_path / "sq.toml"
-    cfg.write_text(SUPERQUADRIC.format(method="nnl", time=4.0))
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(cfg_text)
     full = run(["run", str(cfg), "--out", "full", "--quiet"], tmp_path)
     assert full.returncode == 0, full.stderr
     p = subprocess.Popen([HB, "run", str(cfg), "--out", "part", "--quiet"], cwd=tmp_path,
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(0.8)
+    time.sleep(delay)
     p.send_signal(signal.SIGTERM)
     _, err = p.communicate(timeout=300)
     if p.returncode == 0:
@@ -258,7 +260,76 @@ def test_superquadric_resume_reproduces_uninterrupted_run(tmp_path):
     assert res.returncode == 0, res.stderr
     a = json.loads((tmp_path / "full" / "summary.json").read_text())
     b = json.loads((tmp_path / "part" / "summary.json").read_text())
-    for k in ["collisions", "Z", "energy_drift", "overlaps", "min_distance", "packing_fraction"]:
+    for k in keys:
         assert a[k] == b[k], k
     assert (tmp_path / "full" / "log.tsv").read_text() == (tmp_path / "part" / "log.tsv").read_text()
 
+
+def test_superquadric_resume_reproduces_uninterrupted_run(tmp_path):
+    assert_resume_reproduces(tmp_path, SUPERQUADRIC.format(method="nnl", time=4.0), 0.8,
+                             ["collisions", "Z", "energy_drift", "overlaps", "min_distance",
+                              "packing_fraction"])
+
+
+
+MIXTURE = """
+[system]
+packing_fraction = 0.35
+seed = 4
+[[species]]
+name = "big"
+count = 300
+shape = {{ type = "sphere", radius = 0.5 }}
+polydispersity = {{ distribution = "uniform", width = 0.05 }}
+[[species]]
+name = "small"
+count = 600
+mass = 0.5
+shape = {{ type = "sphere", radius = 0.3 }}
+[run]
+equilibrate_time = 1.0
+time = {time}
+[output]
+log_interval = 0.5
+snapshot_interval = 1.0
+checkpoint_interval = 0.2
+"""
+
+
+def test_mixture_outputs_name_the_species(tmp_path):
+    cfg = tmp_path / "mix.toml"
+    cfg.write_text(MIXTURE.format(time=2.0))
+    r = run(["run", str(cfg), "--out", "o", "--quiet"], tmp_path)
+    assert r.returncode == 0, r.stderr
+    s = json.loads((tmp_path / "o" / "summary.json").read_text())
+    for k in SUMMARY_KEYS:
+        assert k in s, k
+    assert s["particles"] == 900 and s["overlaps"] == 0 and abs(s["energy_drift"]) < 1e-12
+    assert [x["name"] for x in s["species"]] == ["big", "small"]
+    for x in s["species"]:
+        for k in ["name", "count", "mass", "inertia", "temperature_translational",
+                  "temperature_rotational", "temperature_rotational_axes"]:
+            assert k in x, k
+    assert s["species"][1]["mass"] == 0.5 and s["species"][1]["count"] == 600
+    assert {(p["a"], p["b"]) for p in s["species_pairs"]} == {
+        ("big", "big"), ("big", "small"), ("small", "big"), ("small", "small")}
+    assert s["init"]["method"] == "grow"
+    resolved = (tmp_path / "o" / "config.resolved.toml").read_text()
+    assert "[[species]]" in resolved and "name = 'small'" in resolved and "inertia" in resolved
+    gsd_hoomd = pytest.importorskip("gsd.hoomd")
+    with gsd_hoomd.open(str(tmp_path / "o" / "trajectory.gsd"), mode="rb") as t:
+        f = t[-1]
+        assert f.particles.types == ["big", "small"]
+        assert list(np.bincount(f.particles.typeid)) == [300, 600]
+        assert f.particles.type_shapes == [{"type": "Sphere", "diameter": 1.0},
+                                           {"type": "Sphere", "diameter": 0.6}]
+        d = np.asarray(f.particles.diameter)
+        scale = np.asarray(f.log["particles/hardbody/scale"])
+        assert np.allclose(d[:300], scale[:300], rtol=1e-6) and np.std(scale[:300]) > 0.03
+        assert np.allclose(d[300:], 0.6, rtol=1e-6)
+
+
+def test_mixture_resume_reproduces_uninterrupted_run(tmp_path):
+    assert_resume_reproduces(tmp_path, MIXTURE.format(time=30.0), 0.6,
+                             ["collisions", "Z", "energy_drift", "overlaps", "min_distance",
+                              "packing_fraction", "species", "species_pairs"])

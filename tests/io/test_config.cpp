@@ -43,8 +43,8 @@ TEST(Config, GoodConfigParsesWithDefaults) {
   EXPECT_EQ(c.particles, 256u);
   EXPECT_DOUBLE_EQ(c.packing_fraction, 0.3);
   EXPECT_EQ(c.seed, 7u);
-  EXPECT_EQ(shape_name(c.shape), "sphere");
-  EXPECT_DOUBLE_EQ(std::get<Sphere>(c.shape).radius, 0.5);
+  EXPECT_EQ(shape_name(c.one().shape), "sphere");
+  EXPECT_DOUBLE_EQ(std::get<Sphere>(c.one().shape).radius, 0.5);
   EXPECT_DOUBLE_EQ(c.log_interval, 1.0);
   EXPECT_EQ(c.neighbors_method, "cells");
 }
@@ -55,7 +55,7 @@ TEST(Config, ResolvedTomlRoundTrips) {
   EXPECT_EQ(d.particles, c.particles);
   EXPECT_EQ(d.packing_fraction, c.packing_fraction);
   EXPECT_EQ(d.log_interval, 0.25);
-  EXPECT_EQ(d.inertia, c.inertia);
+  EXPECT_EQ(d.one().inertia, c.one().inertia);
 }
 
 TEST(Config, OverridesApply) {
@@ -129,11 +129,90 @@ TEST(Config, ShapeKeysFollowTheShapeType) {
       replace(g, "type = \"sphere\"\nradius = 0.5",
               "type = \"superquadric\"\nsemi_axes = [1.0, 0.5, 0.5]\nexponents = [2, 2, 8]"),
       "cfg.toml");
-  ASSERT_TRUE(std::holds_alternative<Superquadric>(sq.shape));
-  EXPECT_EQ(std::get<Superquadric>(sq.shape).p, 8.0);
+  ASSERT_TRUE(std::holds_alternative<Superquadric>(sq.one().shape));
+  EXPECT_EQ(std::get<Superquadric>(sq.one().shape).p, 8.0);
   EXPECT_EQ(sq.neighbors_method, "nnl");
-  EXPECT_DOUBLE_EQ(sq.inertia, 0.4 * 0.25);  // 2/5 m r_min^2 by default
+  EXPECT_EQ(sq.one().inertia, Vec3::Constant(0.4 * 0.25));  // 2/5 m r_min^2 by default
   // the resolved TOML round-trips the shape
   const Config back = parse_config(to_toml(sq), "resolved.toml");
-  EXPECT_EQ(shape_json(back.shape), shape_json(sq.shape));
+  EXPECT_EQ(shape_json(back.one().shape), shape_json(sq.one().shape));
+}
+
+namespace {
+const char* kMixture = R"(
+[system]
+packing_fraction = 0.3
+[[species]]
+name = "A"
+count = 100
+shape = { type = "sphere", radius = 0.5 }
+[[species]]
+name = "B"
+count = 50
+mass = 0.25
+shape = { type = "sphere", radius = 0.25 }
+polydispersity = { distribution = "gaussian", width = 0.1 }
+[run]
+time = 1.0
+)";
+}  // namespace
+
+TEST(Config, SpeciesTableParsesAndRoundTrips) {
+  const Config c = parse_config(kMixture, "mix.toml");
+  ASSERT_EQ(c.species.size(), 2u);
+  EXPECT_TRUE(c.species_given);
+  EXPECT_TRUE(c.mixture());
+  EXPECT_EQ(c.particles, 150u);
+  EXPECT_EQ(c.species[1].name, "B");
+  EXPECT_EQ(c.species[1].mass, 0.25);
+  EXPECT_EQ(c.species[1].poly.distribution, Polydispersity::Distribution::gaussian);
+  // default inertia: the uniform solid (2/5 m r^2 for a sphere)
+  EXPECT_DOUBLE_EQ(c.species[1].inertia.x(), 0.4 * 0.25 * 0.0625);
+  const Config d = parse_config(to_toml(c), "resolved.toml");
+  ASSERT_EQ(d.species.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(d.species[k].name, c.species[k].name);
+    EXPECT_EQ(d.species[k].count, c.species[k].count);
+    EXPECT_EQ(d.species[k].mass, c.species[k].mass);
+    EXPECT_EQ(d.species[k].inertia, c.species[k].inertia);
+    EXPECT_EQ(d.species[k].poly.width, c.species[k].poly.width);
+    EXPECT_EQ(shape_json(d.species[k].shape), shape_json(c.species[k].shape));
+  }
+  // the shorthand is one species named after its shape
+  const Config one = parse_config(kGood, "cfg.toml");
+  ASSERT_EQ(one.species.size(), 1u);
+  EXPECT_EQ(one.one().name, "sphere");
+  EXPECT_FALSE(one.mixture());
+}
+
+TEST(Config, BadSpeciesNameTheKey) {
+  const std::string m = kMixture;
+  const BadCase cases[] = {
+      {"duplicate name", replace(m, "name = \"B\"", "name = \"A\""),
+       "cfg.toml:9: key 'species[1].name': duplicate species name 'A' (also species[0])"},
+      {"count 0", replace(m, "count = 50", "count = 0"), "key 'species[1].count': must be at least 1"},
+      {"negative mass", replace(m, "mass = 0.25", "mass = -1.0"), "key 'species[1].mass': must be positive"},
+      {"inertia not positive definite", replace(m, "mass = 0.25", "mass = 0.25\ninertia = [0.1, -0.1, 0.1]"),
+       "key 'species[1].inertia': principal moments must be positive"},
+      {"inertia not a rigid body", replace(m, "mass = 0.25", "mass = 0.25\ninertia = [0.1, 0.1, 0.5]"),
+       "key 'species[1].inertia': principal moments of a rigid body satisfy"},
+      {"width 0", replace(m, "width = 0.1", "width = 0.0"), "key 'species[1].polydispersity.width': must be in (0, 0.3)"},
+      {"width 0.3", replace(m, "width = 0.1", "width = 0.3"), "key 'species[1].polydispersity.width'"},
+      {"distribution", replace(m, "\"gaussian\"", "\"lognormal\""), "key 'species[1].polydispersity.distribution'"},
+      {"too dense", replace(m, "packing_fraction = 0.3", "packing_fraction = 0.65"),
+       "key 'system.packing_fraction': 0.65 is too dense for the start of a mixture"},
+      {"unknown key", replace(m, "mass = 0.25", "mass = 0.25\ncolour = 1"), "unknown key 'species[1].colour'"},
+      {"sites", replace(m, "mass = 0.25", "mass = 0.25\nsites = []"), "key 'species[1].sites': square-well sites are not supported yet"},
+      {"shape key", replace(m, "radius = 0.25 }", "radius = 0.25, exponents = [2, 2, 2] }"),
+       "key 'species[1].shape.exponents': does not apply to shape type 'sphere'"},
+      {"no name", replace(m, "name = \"B\"\n", ""), "missing key 'species[1].name'"},
+      {"shape and species", m + "[shape]\ntype = \"sphere\"\nradius = 0.5\n", "[shape] and [[species]] exclude each other"},
+      {"particles and species", replace(m, "packing_fraction = 0.3", "packing_fraction = 0.3\nparticles = 150"),
+       "key 'system.particles': is set per species"},
+  };
+  for (const auto& c : cases) {
+    const std::string msg = error_of(c.text);
+    EXPECT_NE(msg.find(c.expect), std::string::npos)
+        << c.what << ": got message '" << msg << "', expected to contain '" << c.expect << "'";
+  }
 }

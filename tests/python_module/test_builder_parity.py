@@ -14,12 +14,30 @@ import hardbody
 HB_BIN = Path(__file__).resolve().parents[2] / "build" / "apps" / "hardbody" / "hardbody"
 
 
+def toml_value(v):
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{k} = {toml_value(x)}" for k, x in v.items()) + " }"
+    return json.dumps(v)
+
+
 def toml_text(cfg):
-    return "\n".join(f"[{sec}]\n" + "\n".join(f"{k} = {json.dumps(v)}" for k, v in kv.items())
-                     for sec, kv in cfg.items()) + "\n"
+    out = []
+    for sec, kv in cfg.items():
+        for table in (kv if isinstance(kv, list) else [kv]):
+            head = f"[[{sec}]]" if isinstance(kv, list) else f"[{sec}]"
+            out.append(head + "\n" + "\n".join(f"{k} = {toml_value(v)}" for k, v in table.items()))
+    return "\n".join(out) + "\n"
 
 
 CASES = {
+    "polydisperse-binary-spheres": {
+        "system": {"packing_fraction": 0.4, "seed": 6},
+        "species": [
+            {"name": "A", "count": 200, "shape": {"type": "sphere", "radius": 0.5},
+             "polydispersity": {"distribution": "gaussian", "width": 0.08}},
+            {"name": "B", "count": 200, "mass": 0.3, "shape": {"type": "sphere", "radius": 0.3}},
+        ],
+    },
     "grown-ellipsoids": {
         "system": {"particles": 108, "packing_fraction": 0.45, "seed": 3},
         "shape": {"type": "ellipsoid", "semi_axes": [1.0, 0.5, 0.5]},

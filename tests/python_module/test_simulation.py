@@ -282,3 +282,17 @@ def test_correlations_from_python_ballistic_start():
     assert sim.collisions == 0  # (seed 2: no collision in 0.5 time units at this density)
     assert np.allclose(msd[ok], v2 * t[ok] ** 2, rtol=1e-9, atol=1e-12)
     assert abs(c.c2[0] - 1.0) < 1e-12 and np.all(c.fself[ok] <= 1.0 + 1e-12)
+
+
+def test_sphere_mixture_from_dict():
+    cfg = {"system": {"packing_fraction": 0.3, "seed": 1},
+           "species": [{"name": "A", "count": 100, "shape": {"type": "sphere", "radius": 0.5}},
+                       {"name": "B", "count": 100, "mass": 0.5, "shape": {"type": "sphere", "radius": 0.35}}]}
+    sim = hardbody.Simulation(cfg)
+    assert sim.N == 200 and sim.packing_fraction == pytest.approx(0.3, rel=1e-12)
+    e0 = sim.kinetic_energy()
+    sim.run(time=1.0)
+    assert sim.collisions > 100 and sim.overlaps() == 0
+    assert abs(sim.kinetic_energy() / e0 - 1.0) < 1e-12
+    with pytest.raises(ValueError, match=r"species\[1\]\.count"):
+        hardbody.Simulation(dict(cfg, species=[cfg["species"][0], dict(cfg["species"][1], count=0)]))

@@ -19,8 +19,8 @@ Config config(AnyShape shape, std::uint64_t n, double phi, const std::string& me
   c.particles = n;
   c.packing_fraction = phi;
   c.seed = 11;
-  c.shape = shape;
-  c.inertia = 0.4 * c.mass * sqr(half_extents(shape).minCoeff());
+  c.species.at(0) = Species{std::string(shape_name(shape)), n, shape, 1.0,
+                            Vec3::Constant(0.4 * sqr(half_extents(shape).minCoeff())), {}};
   c.neighbors_method = method;
   c.init_method = "lattice";
   return c;
@@ -74,7 +74,7 @@ TEST(Builder, SameTrajectoryAsTheHandAssembledSystem) {
   spec.n = 256;
   spec.phi = 0.4;
   spec.semi_axes = Vec3(1.0, 0.5, 0.5);
-  spec.inertia = c.inertia;
+  spec.inertia = c.one().inertia.x();
   spec.seed = c.seed;
   auto twin = make_ellipsoid_list_simulation(spec, c.shell);
   run_collisions(twin, 3000);
@@ -100,7 +100,7 @@ TEST(Builder, GrowthReachesTheTargetWithoutOverlaps) {
     Start s = as.start();
     EXPECT_EQ(s.info.method, "grow");
     EXPECT_GT(s.info.result.collisions, 0u);
-    EXPECT_NEAR(double(s.state.size()) * volume(c.shape) / s.box.volume(), 0.35, 1e-12);
+    EXPECT_NEAR(double(s.state.size()) * volume(c.one().shape) / s.box.volume(), 0.35, 1e-12);
     EXPECT_EQ(as.ops().overlaps(s.state, s.box).overlaps, 0u);
     auto sim = as.simulate(s.box, std::move(s.state));
     run_collisions(sim, 500);

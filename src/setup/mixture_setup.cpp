@@ -1,0 +1,142 @@
+#include "setup/mixture_setup.hpp"
+
+#include <cmath>
+#include <pcg_random.hpp>
+#include <random>
+#include <stdexcept>
+#include <unordered_map>
+
+namespace hb {
+
+State species_state(const SpeciesTable& species, std::uint64_t seed) {
+  State s;
+  s.resize(total_count(species));
+  pcg64 rng(seed, 0x706f6c7964697370ull);  // stream "polydisp"
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::uniform_real_distribution<double> uni(-1.0, 1.0);
+  std::size_t i = 0;
+  for (std::size_t k = 0; k < species.size(); ++k) {
+    const Polydispersity& p = species[k].poly;
+    for (std::uint64_t c = 0; c < species[k].count; ++c, ++i) {
+      s.species[i] = static_cast<std::uint16_t>(k);
+      double x = 0.0;
+      if (p.distribution == Polydispersity::Distribution::gaussian) {
+        do x = gauss(rng); while (std::abs(x) > 3.0);  // truncated at 3 widths
+      } else if (p.distribution == Polydispersity::Distribution::uniform) {
+        x = std::sqrt(3.0) * uni(rng);  // standard deviation 1
+      }
+      s.scale[i] = 1.0 + p.width * x;
+    }
+  }
+  return s;
+}
+
+double body_volume(const SpeciesTable& species, const State& s) {
+  double v = 0.0;
+  for (std::size_t i = 0; i < s.size(); ++i) v += volume(species[s.species[i]].shape) * std::pow(s.scale[i], 3);
+  return v;
+}
+
+std::vector<Vec3> random_sphere_placement(const std::vector<double>& radii, const Box& box,
+                                          std::uint64_t seed) {
+  pcg64 rng(seed, 0x706c6163656d656eull);  // stream "placemen"
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  double rmax = 0.0;
+  for (double r : radii) rmax = std::max(rmax, r);
+  // cells of side >= 2 rmax: a new sphere can only touch spheres in its own and adjacent cells
+  Eigen::Vector3i nc;
+  for (int k = 0; k < 3; ++k) nc[k] = std::max(1, int(box.L[k] / (2.0 * rmax)));
+  auto cell_of = [&](const Vec3& r) {
+    Eigen::Vector3i c;
+    for (int k = 0; k < 3; ++k) c[k] = std::min(nc[k] - 1, int(r[k] / box.L[k] * nc[k]));
+    return c;
+  };
+  auto key = [&](const Eigen::Vector3i& c) {
+    return (std::int64_t(c.x()) * nc.y() + c.y()) * nc.z() + c.z();
+  };
+  std::unordered_map<std::int64_t, std::vector<std::uint32_t>> cells;
+  std::vector<Vec3> pos;
+  pos.reserve(radii.size());
+  for (std::size_t i = 0; i < radii.size(); ++i) {
+    bool placed = false;
+    for (int attempt = 0; attempt < 10000 && !placed; ++attempt) {
+      const Vec3 r(u(rng) * box.L.x(), u(rng) * box.L.y(), u(rng) * box.L.z());
+      const Eigen::Vector3i c = cell_of(r);
+      bool free = true;
+      for (int dx = -1; dx <= 1 && free; ++dx)
+        for (int dy = -1; dy <= 1 && free; ++dy)
+          for (int dz = -1; dz <= 1 && free; ++dz) {
+            Eigen::Vector3i d(c.x() + dx, c.y() + dy, c.z() + dz);
+            for (int k = 0; k < 3; ++k) d[k] = (d[k] + nc[k]) % nc[k];
+            const auto it = cells.find(key(d));
+            if (it == cells.end()) continue;
+            for (std::uint32_t j : it->second)
+              if (box.minimum_image(pos[j] - r).norm() < radii[i] + radii[j]) {
+                free = false;
+                break;
+              }
+          }
+      if (free) {
+        cells[key(c)].push_back(static_cast<std::uint32_t>(i));
+        pos.push_back(r);
+        placed = true;
+      }
+    }
+    if (!placed)
+      throw std::invalid_argument("random placement: no room for body " + std::to_string(i) +
+                                  " (the dilute packing fraction init.phi0 is too high)");
+  }
+  return pos;
+}
+
+void maxwell_boltzmann(State& s, double kT, const std::vector<double>& masses, std::uint64_t seed) {
+  pcg64 rng(seed, 0x68617264626f6479ull);  // stream "hardbody"
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  const std::size_t n = s.size();
+  Vec3 p = Vec3::Zero();
+  double mtot = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    s.v[i] = std::sqrt(kT / masses[i]) * Vec3(gauss(rng), gauss(rng), gauss(rng));
+    p += masses[i] * s.v[i];
+    mtot += masses[i];
+  }
+  const Vec3 vcm = p / mtot;
+  double k = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    s.v[i] -= vcm;
+    k += 0.5 * masses[i] * s.v[i].squaredNorm();
+  }
+  if (k > 0.0) {
+    const double f = std::sqrt(1.5 * double(n) * kT / k);
+    for (auto& v : s.v) v *= f;
+  }
+}
+
+GrowthResult grow_sphere_mixture(const SpeciesTable& species, double phi, std::uint64_t seed,
+                                 const GrowthOptions& opt) {
+  if (!(opt.phi0 > 0.0) || opt.phi0 > phi) throw std::invalid_argument("grow_sphere_mixture: need 0 < phi0 <= phi");
+  State st = species_state(species, seed);
+  Box box;
+  box.L = Vec3::Constant(std::cbrt(body_volume(species, st) / phi));
+  const double s0 = std::cbrt(opt.phi0 / phi);
+  HardSphereMixture model = HardSphereMixture::of(species, GrowthLaw{s0, opt.rate, 0.0, (1.0 - s0) / opt.rate});
+  std::vector<double> radii(st.size()), masses(st.size());
+  for (std::size_t i = 0; i < st.size(); ++i) {
+    radii[i] = model.body_radius(st, i) * s0;
+    masses[i] = model.body_mass(st, i);
+  }
+  st.r = random_sphere_placement(radii, box, seed);
+  maxwell_boltzmann(st, opt.kT, masses, seed);
+  auto thermostat = [&](State& x) {
+    const double k = model.kinetic_energy(x);
+    const double f = std::sqrt(1.5 * double(x.size()) * opt.kT / k);
+    for (auto& v : x.v) v *= f;
+    return k - model.kinetic_energy(x);
+  };
+  GrowthResult res = s0 < 1.0 ? run_growth(model, std::move(st), box, opt, thermostat) : GrowthResult{};
+  if (s0 >= 1.0) res.state = std::move(st), res.box = box, res.s0 = 1.0;
+  res.phi = body_volume(species, res.state) / box.volume();
+  return res;
+}
+
+}  // namespace hb

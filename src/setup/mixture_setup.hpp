@@ -1,0 +1,40 @@
+// Starts of mixtures and polydisperse systems (sphere species so far): each body's species and
+// size scale, random placement of the bodies at a dilute packing fraction, Maxwell–Boltzmann
+// velocities with per-body masses, and Lubachevsky–Stillinger growth to the target
+// (docs/initial_states.md).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "core/species.hpp"
+#include "setup/growth.hpp"
+#include "system/box.hpp"
+#include "system/hard_sphere_mixture.hpp"
+#include "system/state.hpp"
+
+namespace hb {
+
+// A state of total_count(species) bodies in species order (all of species 0, then 1, ...), each
+// with its size scale drawn from its species' polydispersity (a stream of its own of `seed`).
+State species_state(const SpeciesTable& species, std::uint64_t seed);
+
+// Sum of the body volumes: sum_i v(species_i) scale_i^3.
+double body_volume(const SpeciesTable& species, const State& s);
+
+// Places spheres of the given radii uniformly at random in the box, none overlapping an earlier
+// one (random sequential addition, candidates from a cell grid); throws std::invalid_argument
+// when a body finds no place in 10^4 attempts.
+std::vector<Vec3> random_sphere_placement(const std::vector<double>& radii, const Box& box,
+                                          std::uint64_t seed);
+
+// Gaussian velocities with per-body masses, zero total momentum, rescaled so that
+// 2 K / (3 N) = kT exactly (deterministic for the seed).
+void maxwell_boltzmann(State& s, double kT, const std::vector<double>& masses, std::uint64_t seed);
+
+// The dense start of a sphere mixture at packing fraction phi (of the target sizes): random
+// placement of bodies shrunk by s0 = (phi0 / phi)^(1/3) in the target box, then growth to s = 1
+// with the thermostat at opt.kT. The result's state is synchronized, time stamps 0.
+GrowthResult grow_sphere_mixture(const SpeciesTable& species, double phi, std::uint64_t seed,
+                                 const GrowthOptions& opt);
+
+}  // namespace hb
