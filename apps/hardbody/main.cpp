@@ -41,6 +41,8 @@ int main(int argc, char** argv) {
   cmd_ct->add_option("file", ct_file, "JSON-lines input (default stdin)");
   cmd_ct->add_option("--eps-d", ct_eps, "distance accuracy epsilon_d")->check(CLI::PositiveNumber);
 
+  auto* cmd_ref = app.add_subcommand("config-reference", "print the reference of every config key (docs/config.md)");
+
   std::string plot_dir;
   auto* cmd_plot = app.add_subcommand("plot", "write PNG plots of a run directory");
   cmd_plot->add_option("run_dir", plot_dir, "run directory")->required();
@@ -53,6 +55,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (cmd_run->parsed()) hb::run_simulation(run);
+    if (cmd_ref->parsed()) std::cout << hb::config_reference();
     auto lines = [](const std::string& file, auto&& fn) {
       if (file.empty()) return fn(std::cin, std::string("<stdin>"));
       std::ifstream in(file);

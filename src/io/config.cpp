@@ -17,25 +17,53 @@ namespace hb {
 
 namespace {
 
-// The schema: section -> key -> kind.
 enum class Kind { Int, Float, String, Bool, Vec3 };
-const std::map<std::string, std::map<std::string, Kind>>& schema() {
-  static const std::map<std::string, std::map<std::string, Kind>> s = {
-      {"system",
-       {{"particles", Kind::Int}, {"packing_fraction", Kind::Float}, {"seed", Kind::Int},
-        {"temperature", Kind::Float}, {"mass", Kind::Float}}},
-      {"run", {{"equilibrate_time", Kind::Float}, {"time", Kind::Float}, {"max_collisions", Kind::Int}}},
-      {"neighbors", {{"method", Kind::String}, {"shell", Kind::Float}}},
-      {"solver", {{"eps_d", Kind::Float}}},
-      {"output",
-       {{"log_interval", Kind::Float}, {"snapshot_interval", Kind::Float},
-        {"checkpoint_interval", Kind::Float}, {"trajectory", Kind::Bool}}},
-      {"init", {{"method", Kind::String}, {"phi0", Kind::Float}, {"growth_rate", Kind::Float}}},
-      {"observables",
-       {{"interval", Kind::Float}, {"origin_every", Kind::Int}, {"max_lag", Kind::Float},
-        {"q", Kind::Float}, {"q_vectors", Kind::Int}, {"gr_interval", Kind::Float},
-        {"gr_bins", Kind::Int}}},
+
+// THE schema of the scalar sections: every key with its kind and meaning. Unknown keys are
+// rejected against it, and docs/config.md is generated from it (config_reference()).
+struct KeySpec {
+  const char* section;
+  const char* key;
+  Kind kind;
+  const char* meaning;
+};
+const std::vector<KeySpec>& key_specs() {
+  static const std::vector<KeySpec> k = {
+      {"system", "particles", Kind::Int, "N, the number of bodies (one-species shorthand, required with [shape]; with [[species]] the counts add up and this key is refused)"},
+      {"system", "packing_fraction", Kind::Float, "target packing fraction phi = sum of body volumes / box volume (required)"},
+      {"system", "seed", Kind::Int, "seed of every random choice (lattice velocities, placement, polydispersity)"},
+      {"system", "temperature", Kind::Float, "kT: the translational (and rotational) temperature set at the start"},
+      {"system", "mass", Kind::Float, "body mass (one-species shorthand; per species with [[species]])"},
+      {"run", "equilibrate_time", Kind::Float, "simulated time run and discarded before measuring"},
+      {"run", "time", Kind::Float, "simulated time measured (required)"},
+      {"run", "max_collisions", Kind::Int, "stop the measured run after this many collisions (0: no limit)"},
+      {"neighbors", "method", Kind::String, "\"cells\" or \"nnl\" (oriented-box / sphere-shell neighbour lists); default cells for spheres, nnl otherwise; mixtures use cells"},
+      {"neighbors", "shell", Kind::Float, "Delta_NNL: the neighbour-list shell (a length)"},
+      {"solver", "eps_d", Kind::Float, "the paper's epsilon_d: the distance accuracy of the contact-time search"},
+      {"output", "log_interval", Kind::Float, "simulated time per log.tsv row and per pressure block"},
+      {"output", "snapshot_interval", Kind::Float, "simulated time between trajectory frames (each checked for overlaps)"},
+      {"output", "checkpoint_interval", Kind::Float, "wall seconds between checkpoints (also written on SIGINT/SIGTERM and failures)"},
+      {"output", "trajectory", Kind::Bool, "write trajectory.gsd"},
+      {"init", "method", Kind::String, "dense start of non-spherical bodies: \"grow\" (Lubachevsky-Stillinger from init.phi0) or \"lattice\" (stretched lattice at the target); mixtures always grow from a random placement"},
+      {"init", "phi0", Kind::Float, "packing fraction of the dilute start that is grown"},
+      {"init", "growth_rate", Kind::Float, "d(scale)/dt of the growth (scale 1 = target size)"},
+      {"observables", "interval", Kind::Float, "sampling interval of MSD, C2, F_self (0: off)"},
+      {"observables", "origin_every", Kind::Int, "a new time origin every this many samples"},
+      {"observables", "max_lag", Kind::Float, "longest lag time of the correlation tables"},
+      {"observables", "q", Kind::Float, "target |q| of F_self(q, t)"},
+      {"observables", "q_vectors", Kind::Int, "number of q vectors averaged"},
+      {"observables", "gr_interval", Kind::Float, "sampling interval of g(r) (0: off)"},
+      {"observables", "gr_bins", Kind::Int, "bins of g(r)"},
   };
+  return k;
+}
+
+const std::map<std::string, std::map<std::string, Kind>>& schema() {
+  static const std::map<std::string, std::map<std::string, Kind>> s = [] {
+    std::map<std::string, std::map<std::string, Kind>> m;
+    for (const KeySpec& k : key_specs()) m[k.section][k.key] = k.kind;
+    return m;
+  }();
   return s;
 }
 
@@ -513,6 +541,83 @@ std::string to_toml(const Config& c) {
   std::ostringstream os;
   os << "# hardbody resolved configuration (every key, defaults filled in)\n" << root << "\n";
   return os.str();
+}
+
+namespace {
+const char* kind_doc(Kind k) {
+  switch (k) {
+    case Kind::Int: return "integer";
+    case Kind::Float: return "number";
+    case Kind::String: return "string";
+    case Kind::Bool: return "bool";
+    case Kind::Vec3: return "3 numbers";
+  }
+  return "?";
+}
+}  // namespace
+
+// A markdown table cell: '|' would end the cell.
+static std::string cell(std::string_view text) {
+  std::string out;
+  for (char ch : text) out += ch == '|' ? std::string("\\|") : std::string(1, ch);
+  return out;
+}
+
+std::string config_reference() {
+  // defaults: a minimal config, resolved
+  const Config defaults = parse_config(
+      "[system]\nparticles = 256\npacking_fraction = 0.3\n[shape]\ntype = \"sphere\"\nradius = 0.5\n"
+      "[run]\ntime = 1.0\n", "defaults");
+  const toml::table resolved = toml::parse(to_toml(defaults));
+  auto default_of = [&](const std::string& sec, const std::string& key) -> std::string {
+    if ((sec == "system" && (key == "particles" || key == "packing_fraction")) || (sec == "run" && key == "time"))
+      return "required";
+    if (sec == "neighbors" && key == "method") return "by shape";
+    const auto* t = resolved.get_as<toml::table>(sec);
+    const auto* n = t ? t->get(key) : nullptr;
+    if (!n) return "";
+    if (auto d = n->value_exact<double>()) return fmt::format("{:g}", *d);
+    if (auto i = n->value_exact<int64_t>()) return fmt::format("{}", *i);
+    if (auto b = n->value_exact<bool>()) return *b ? "true" : "false";
+    if (auto str = n->value_exact<std::string>()) return "\"" + *str + "\"";
+    return "";
+  };
+  std::string out =
+      "# Configuration keys\n\n"
+      "Generated from the schema in `src/io/config.cpp` and the shape registry\n"
+      "(`hardbody config-reference > docs/config.md`; a test fails when this file is out of date).\n"
+      "Every key is checked: an unknown key, a wrong type or a value out of range stops the program with\n"
+      "exit status 2 and one message naming the file, the key and the line. `--set section.key=value`\n"
+      "overrides any scalar key.\n";
+  std::string sec;
+  for (const KeySpec& k : key_specs()) {
+    if (k.section != sec) {
+      sec = k.section;
+      out += fmt::format("\n## [{}]\n\n| key | type | default | meaning |\n|---|---|---|---|\n", sec);
+    }
+    out += fmt::format("| `{}` | {} | {} | {} |\n", k.key, kind_doc(k.kind), default_of(k.section, k.key), cell(k.meaning));
+  }
+  out += "\n## [shape] (one species; or the `shape` of each [[species]])\n\n"
+         "| key | meaning |\n|---|---|\n"
+         "| `type` | the shape: " + shape_names() + " (required) |\n"
+         "| `inertia` | [shape] only: scalar moment of inertia of the spherical top; default 2/5 m r_min^2 (the paper's convention) |\n";
+  for_each_shape_type([&](auto s) {
+    using S = decltype(s);
+    out += fmt::format("| type = \"{}\" | {} |\n", S::kName, cell(ShapeCodec<S>::kDoc));
+    return false;
+  });
+  out += "\n## [[species]] (a mixture; replaces [shape], system.particles and system.mass)\n\n"
+         "| key | type | default | meaning |\n|---|---|---|---|\n"
+         "| `name` | string | required | GSD type name; unique |\n"
+         "| `count` | integer | required | bodies of this species (>= 1) |\n"
+         "| `shape` | table | required | `{ type = ..., ... }` as [shape] above |\n"
+         "| `mass` | number | 1 | body mass at scale 1 |\n"
+         "| `inertia` | number or 3 numbers | uniform solid | principal moments along body x, y, z (positive, I_a + I_b >= I_c); one number: a spherical top |\n"
+         "| `polydispersity` | table | none | `{ distribution = \"gaussian\" or \"uniform\", width = w }`: body sizes scaled by s with mean 1 and relative standard deviation w in (0, 0.3) (gaussian truncated at 3 w); mass scales as s^3, inertia as s^5 |\n"
+         "\nMixtures start from a random placement at `init.phi0` grown to `system.packing_fraction` (at most 0.6)\n"
+         "and use cell lists. So far every species of a mixture must be a sphere, and non-spherical bodies\n"
+         "must be spherical tops.\n";
+  return out;
 }
 
 }  // namespace hb

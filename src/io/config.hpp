@@ -16,5 +16,7 @@ Config parse_config(const std::string& text, const std::string& name,
                     const std::vector<std::string>& overrides = {});
 // The fully resolved config, every key present, as TOML text.
 std::string to_toml(const Config& c);
+// Markdown reference of every key (docs/config.md), generated from the schema and the registry.
+std::string config_reference();
 
 }  // namespace hb

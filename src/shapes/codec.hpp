@@ -38,13 +38,14 @@ class ParamWriter {
 template <class S>
 struct ShapeCodec;
 
-// Each entry: kKeys (its parameters), read (checked), write, and the packing fraction a start
-// must stay below (kPackingLimit, with the reason for messages).
+// Each entry: kKeys (its parameters), read (checked), write, the packing fraction a start must
+// stay below (kPackingLimit, with the reason for messages) and kDoc (docs/config.md).
 template <>
 struct ShapeCodec<Sphere> {
   static constexpr std::array<std::string_view, 1> kKeys{"radius"};
   static constexpr double kPackingLimit = 0.74;
   static constexpr const char* kPackingNote = "the densest sphere packing is 0.7405";
+  static constexpr const char* kDoc = "`radius` = r > 0";
   static Sphere read(const ParamReader& r) {
     const double radius = r.number("radius");
     if (!(radius > 0.0)) r.fail("radius", fmt::format("must be positive (got {})", radius));
@@ -64,6 +65,7 @@ struct ShapeCodec<Ellipsoid> {
   static constexpr std::array<std::string_view, 1> kKeys{"semi_axes"};
   static constexpr double kPackingLimit = 0.7707;
   static constexpr const char* kPackingNote = "the densest known ellipsoid packing";
+  static constexpr const char* kDoc = "`semi_axes` = [a, b, c] > 0 along body x, y, z";
   static Ellipsoid read(const ParamReader& r) {
     const Vec3 a = read_semi_axes(r);
     return Ellipsoid{a.x(), a.y(), a.z()};
@@ -76,6 +78,8 @@ struct ShapeCodec<Superquadric> {
   static constexpr std::array<std::string_view, 2> kKeys{"semi_axes", "exponents"};
   static constexpr double kPackingLimit = 0.7707;  // as ellipsoids (the p = 2 case); no tighter bound known to us
   static constexpr const char* kPackingNote = "the densest known ellipsoid packing";
+  static constexpr const char* kDoc =
+      "`semi_axes` = [a, b, c] > 0 and `exponents` = [n, m, p] >= 2: |x/a|^n + |y/b|^m + |z/c|^p <= 1";
   static Superquadric read(const ParamReader& r) {
     const Vec3 a = read_semi_axes(r);
     const Vec3 e = r.triple("exponents");

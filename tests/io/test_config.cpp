@@ -2,6 +2,8 @@
 // line where the file has one).
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include "io/config.hpp"
@@ -215,4 +217,16 @@ TEST(Config, BadSpeciesNameTheKey) {
     EXPECT_NE(msg.find(c.expect), std::string::npos)
         << c.what << ": got message '" << msg << "', expected to contain '" << c.expect << "'";
   }
+}
+
+// docs/config.md is generated from the schema: it lists every key, and it is up to date.
+TEST(Config, ReferenceIsGeneratedAndUpToDate) {
+  const std::string ref = config_reference();
+  for (const char* key : {"`packing_fraction`", "`eps_d`", "`gr_bins`", "`growth_rate`", "`polydispersity`",
+                          "type = \"superquadric\"", "`exponents`"})
+    EXPECT_NE(ref.find(key), std::string::npos) << key;
+  std::ifstream in(std::string(HB_SOURCE_DIR) + "/docs/config.md");
+  ASSERT_TRUE(in) << "docs/config.md missing: build/apps/hardbody/hardbody config-reference > docs/config.md";
+  const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(doc, ref) << "docs/config.md is out of date: build/apps/hardbody/hardbody config-reference > docs/config.md";
 }
