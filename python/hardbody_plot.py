@@ -9,6 +9,7 @@ PNG figures next to them:
                                     c2.png      C2(t) (and C1(t) when present)
                                     fself.png   F_self(q, t)
     gr.tsv (or structure.tsv)    -> gr.png      g(r)
+    gr_partial.tsv (mixtures)    -> gr_partial.png  g_ab(r) of every species pair
     nematic.tsv                  -> s2.png      S2 vs time
 
 A missing table is skipped with a note on stderr. A missing RUN_DIR, or a table that cannot be
@@ -186,6 +187,20 @@ class Plotter:
     def gr(self, path: Path) -> None:
         self.simple(path, "r", "g", "gr.png", "radial distribution function g(r)", hline=1.0)
 
+    def gr_partial(self, path: Path) -> None:
+        _, c = read_table(path)
+        require(c, path, "r")
+        pairs = [k for k in c if k.startswith("g_")]
+        if not pairs:
+            raise TableError(f"{path}: no g_<a>_<b> column")
+        fig, ax = self.figure("r", "g_ab(r)", "partial radial distribution functions")
+        for k in pairs:
+            xs, ys = finite_pairs(c["r"], c[k])
+            ax.plot(xs, ys, "-", label=k[2:].replace("_", "-", 1))
+        ax.axhline(1.0, color="gray", lw=0.8)
+        ax.legend()
+        self.save(fig, "gr_partial.png")
+
     def nematic(self, path: Path) -> None:
         self.simple(path, "time", "S2", "s2.png", "nematic order parameter")
 
@@ -207,6 +222,8 @@ def main(argv: list[str]) -> int:
         (gr_file or run_dir / "gr.tsv", plotter.gr, "gr.png"),
         (run_dir / "nematic.tsv", plotter.nematic, "s2.png"),
     ]
+    if (run_dir / "gr_partial.tsv").is_file():  # mixtures only: no note when absent
+        jobs.append((run_dir / "gr_partial.tsv", plotter.gr_partial, "gr_partial.png"))
     try:
         for path, plot, outputs in jobs:
             if not path.is_file():

@@ -152,6 +152,7 @@ void add_checkpoint_logs(gsd::HoomdFrame& f, const State& s, const LoopSnapshot&
   f.log["hardbody/obs_gr"] = row(d.gr);
   f.log["hardbody/obs_nematic"] = row(d.nematic);
   f.log["hardbody/pair_collisions"] = row(d.pair_collisions);
+  f.log["hardbody/obs_gr_partial"] = row(d.gr_partial);
   f.log["hardbody/config"] = row(config_signature(c).values);
 }
 
@@ -263,6 +264,7 @@ void read_core(const Reader& r, Box& box, State& s, LoopSnapshot& loop, DriverSt
   d.gr = record("hardbody/obs_gr");
   d.nematic = record("hardbody/obs_nematic");
   d.pair_collisions = record("hardbody/pair_collisions");
+  d.gr_partial = record("hardbody/obs_gr_partial");
 }
 
 void decode(const Reader& r, std::vector<std::array<int, 3>>& out) {

@@ -133,11 +133,13 @@ class Driver {
          const DriverState& st, const SystemOps& ops, nlohmann::json extra)
       : cfg_(cfg), opt_(opt), dir_(dir), sim_(sim), st_(st), ops_(ops),
         extra_(std::move(extra)),
-        corr_(correlation_spec(cfg)), rdf_(rdf_spec(cfg)) {
+        corr_(correlation_spec(cfg)), rdf_(rdf_spec(cfg)),
+        gr_partial_(cfg.species.size(), int(cfg.gr_bins)) {
     if (!st_.pressure.empty()) pressure_.load(st_.pressure);
     if (!st_.corr.empty()) corr_.load(st_.corr);
     if (!st_.gr.empty()) rdf_.load(st_.gr);
     if (!st_.nematic.empty()) nem_.load(st_.nematic);
+    if (!st_.gr_partial.empty()) gr_partial_.load(st_.gr_partial);
     const std::size_t ns = cfg_.species.size();
     st_.pair_collisions.resize(ns * (ns + 1) / 2, 0.0);
   }
@@ -259,6 +261,7 @@ class Driver {
     st_.corr = corr_.save();
     st_.gr = rdf_.save();
     st_.nematic = nem_.save();
+    if (partial_gr()) st_.gr_partial = gr_partial_.save();
     if (st_.phase == 1) {
       const double c = cpu_seconds(), w = progress_.wall_seconds();
       st_.cpu_prev += c - cpu_mark_;
@@ -283,6 +286,7 @@ class Driver {
     }
     if (gr) {
       rdf_.sample(sim_.now(), s, sim_.box());
+      if (partial_gr()) gr_partial_.sample(sim_.now(), s, sim_.box(), rdf_.r_max());
       st_.next_gr += cfg_.gr_interval;
     }
   }
@@ -291,6 +295,7 @@ class Driver {
     if (const int sig = g_signal.load()) throw Interrupted(sig);
     if (progress_.wall_seconds() - last_checkpoint_ >= cfg_.checkpoint_interval) write_checkpoint();
   }
+  bool partial_gr() const { return cfg_.species.size() > 1; }
   double energy() const { return ops_.kinetic(sim_.state()); }
   // translational temperature 2 K_trans / (3 N)
   double temperature() const { return ops_.temperature(sim_.state()); }
@@ -431,6 +436,11 @@ class Driver {
       write_file_atomic(dir_ + "/correlations.tsv", corr_.to_tsv());
     }
     if (cfg_.gr_interval > 0.0) write_file_atomic(dir_ + "/gr.tsv", rdf_.to_tsv());
+    if (cfg_.gr_interval > 0.0 && partial_gr()) {
+      std::vector<std::string> names;
+      for (const Species& sp : cfg_.species) names.push_back(sp.name);
+      write_file_atomic(dir_ + "/gr_partial.tsv", gr_partial_.to_tsv(names));
+    }
     write_file_atomic(dir_ + "/nematic.tsv", nem_.to_tsv());
     for (const auto& [k, v] : extra_.items()) j[k] = v;
     log.commit();
@@ -454,6 +464,7 @@ class Driver {
   VirialPressure pressure_;
   TimeCorrelations corr_;
   RadialDistribution rdf_;
+  PartialRadialDistribution gr_partial_;  // mixtures: g_ab(r)
   NematicOrder nem_;
   Progress progress_;
   double cpu_mark_ = 0.0, wall_mark_ = 0.0, last_checkpoint_ = 0.0;

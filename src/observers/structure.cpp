@@ -28,6 +28,13 @@ void check_range(const Box& box, double r_max) {
                                 " must be in (0, min(L)/2 = " + std::to_string(0.5 * box.L.minCoeff()) + "]");
 }
 
+void append_row(std::string& out, const std::vector<double>& xs) {
+  char buf[48];
+  for (std::size_t k = 0; k < xs.size(); ++k) {
+    std::snprintf(buf, sizeof buf, k == 0 ? "%.10g" : "\t%.10g", xs[k]);
+    out += buf;
+  }
+}
 void append_row(std::string& out, std::initializer_list<double> xs) {
   char buf[48];
   bool first = true;
@@ -193,6 +200,107 @@ std::string RadialDistribution::to_tsv() const {
   for (std::size_t k = 0; k < r.size(); ++k) {
     append_row(out, {r[k], g[k], c[k]});
     out += '\t' + std::to_string(hist_[k]) + '\n';
+  }
+  return out;
+}
+
+PartialRadialDistribution::PartialRadialDistribution(std::size_t species, int bins)
+    : ns_(species), bins_(bins) {
+  if (bins < 1) throw std::invalid_argument("PartialRadialDistribution: bins must be >= 1");
+  density_.assign(ns_ * (ns_ + 1) / 2, 0.0);
+  hist_.assign(density_.size(), std::vector<std::uint64_t>(std::size_t(bins), 0));
+}
+
+std::size_t PartialRadialDistribution::pair_index(std::size_t a, std::size_t b) const {
+  if (a > b) std::swap(a, b);
+  return a * ns_ - a * (a - 1) / 2 + (b - a);
+}
+
+void PartialRadialDistribution::sample(double time, const State& state, const Box& box, double r_max) {
+  if (samples_ > 0 && r_max != r_max_) throw std::invalid_argument("PartialRadialDistribution: r_max changed");
+  r_max_ = r_max;
+  std::vector<std::vector<Vec3>> pos(ns_);
+  for (std::size_t i = 0; i < state.size(); ++i) {
+    Vec3 p = state.position_at(i, time);
+    box.wrap(p);
+    pos[state.species[i]].push_back(p);
+  }
+  auto histogram = [&](const std::vector<Vec3>& x) {
+    std::vector<std::uint64_t> h(std::size_t(bins_), 0);
+    if (x.size() > 20000) pair_histogram_cells(x, box, r_max, h);
+    else pair_histogram_brute(x, box, r_max, h);
+    return h;
+  };
+  std::vector<std::vector<std::uint64_t>> own(ns_);
+  for (std::size_t a = 0; a < ns_; ++a) own[a] = histogram(pos[a]);
+  const double V = box.volume();
+  for (std::size_t a = 0; a < ns_; ++a)
+    for (std::size_t b = a; b < ns_; ++b) {
+      const std::size_t k = pair_index(a, b);
+      const double na = double(pos[a].size()), nb = double(pos[b].size());
+      if (a == b) {
+        for (int i = 0; i < bins_; ++i) hist_[k][i] += own[a][i];
+        density_[k] += 0.5 * na * (na - 1.0) / V;
+      } else {
+        std::vector<Vec3> both = pos[a];
+        both.insert(both.end(), pos[b].begin(), pos[b].end());
+        const auto h = histogram(both);
+        for (int i = 0; i < bins_; ++i) hist_[k][i] += h[i] - own[a][i] - own[b][i];
+        density_[k] += na * nb / V;
+      }
+    }
+  ++samples_;
+}
+
+std::vector<double> PartialRadialDistribution::g(std::size_t a, std::size_t b) const {
+  const std::size_t k = pair_index(a, b);
+  std::vector<double> g(std::size_t(bins_), 0.0);
+  if (density_[k] <= 0.0) return g;
+  const double dr = r_max_ / double(bins_);
+  for (int i = 0; i < bins_; ++i) {
+    const double shell = 4.0 / 3.0 * kPi * (std::pow((i + 1) * dr, 3) - std::pow(i * dr, 3));
+    g[i] = double(hist_[k][i]) / (density_[k] * shell);
+  }
+  return g;
+}
+
+std::vector<double> PartialRadialDistribution::save() const {
+  std::vector<double> d{r_max_, double(samples_), double(ns_), double(bins_)};
+  d.insert(d.end(), density_.begin(), density_.end());
+  for (const auto& h : hist_)
+    for (auto x : h) d.push_back(double(x));
+  return d;
+}
+
+void PartialRadialDistribution::load(const std::vector<double>& d) {
+  const std::size_t np = density_.size();
+  if (d.size() != 4 + np + np * std::size_t(bins_) || d[2] != double(ns_) || d[3] != double(bins_))
+    throw std::invalid_argument("partial g(r) record: wrong length, species or bin count");
+  r_max_ = d[0];
+  samples_ = int(d[1]);
+  for (std::size_t k = 0; k < np; ++k) density_[k] = d[4 + k];
+  for (std::size_t k = 0; k < np; ++k)
+    for (int i = 0; i < bins_; ++i) hist_[k][i] = std::uint64_t(d[4 + np + k * bins_ + i]);
+}
+
+std::string PartialRadialDistribution::to_tsv(const std::vector<std::string>& names) const {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "# hardbody partial radial distribution functions g_ab(r)\n# samples=%d r_max=%.10g bins=%d\n",
+                samples_, r_max_, bins_);
+  std::string out = buf;
+  out += "r";
+  for (std::size_t a = 0; a < ns_; ++a)
+    for (std::size_t b = a; b < ns_; ++b) out += "\tg_" + names.at(a) + "_" + names.at(b);
+  out += "\n";
+  std::vector<std::vector<double>> gs;
+  for (std::size_t a = 0; a < ns_; ++a)
+    for (std::size_t b = a; b < ns_; ++b) gs.push_back(g(a, b));
+  const double dr = r_max_ / double(bins_);
+  for (int i = 0; i < bins_; ++i) {
+    std::vector<double> row{(double(i) + 0.5) * dr};
+    for (const auto& g : gs) row.push_back(g[i]);
+    append_row(out, row);
+    out += "\n";
   }
   return out;
 }

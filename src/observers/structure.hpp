@@ -73,6 +73,35 @@ class RadialDistribution {
   std::vector<Vec3> pos_;          // scratch
 };
 
+// Partial radial distribution functions g_ab(r) of a mixture, one per species pair a <= b, on
+// the bins of a given r_max. Histograms add, so the pairs of a and b are counted with the
+// tested pair_histogram_* functions: pairs_aa = H(a), pairs_ab = H(a + b) - H(a) - H(b) for
+// a != b (H(x): the histogram of the centres of the bodies in x). Normalisation: the ideal-gas
+// pair density N_a (N_a - 1) / (2 V) for a = b, N_a N_b / V for a != b.
+class PartialRadialDistribution {
+ public:
+  PartialRadialDistribution(std::size_t species, int bins);
+  // r_max <= half the shortest box edge (the driver takes the whole g(r)'s).
+  void sample(double time, const State& state, const Box& box, double r_max);
+  std::size_t pair_index(std::size_t a, std::size_t b) const;  // a <= b
+  std::vector<double> g(std::size_t a, std::size_t b) const;
+  const std::vector<std::uint64_t>& pair_counts(std::size_t a, std::size_t b) const {
+    return hist_[pair_index(a, b)];
+  }
+  std::vector<double> save() const;
+  void load(const std::vector<double>& record);
+  // Table: '#' comment lines, header r g_<A>_<B> ... (a <= b in species order), one row per bin.
+  std::string to_tsv(const std::vector<std::string>& names) const;
+
+ private:
+  std::size_t ns_;
+  int bins_;
+  double r_max_ = 0.0;
+  int samples_ = 0;
+  std::vector<double> density_;                  // per pair: sum over samples of its pair density
+  std::vector<std::vector<std::uint64_t>> hist_;  // per pair
+};
+
 // Nematic order of the body axes u_i = q_i * body_axis:
 // Q = (1/N) sum_i (3 u_i u_i^T - I) / 2; S2 = its largest eigenvalue, director = its eigenvector
 // (sign chosen so that the largest-magnitude component is positive).

@@ -314,6 +314,11 @@ def test_mixture_outputs_name_the_species(tmp_path):
     assert {(p["a"], p["b"]) for p in s["species_pairs"]} == {
         ("big", "big"), ("big", "small"), ("small", "big"), ("small", "small")}
     assert s["init"]["method"] == "grow"
+    gp = (tmp_path / "o" / "gr_partial.tsv").read_text().splitlines()
+    assert "r\tg_big_big\tg_big_small\tg_small_small" in gp
+    r = run(["plot", "o"], tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "o" / "gr_partial.png").is_file()
     resolved = (tmp_path / "o" / "config.resolved.toml").read_text()
     assert "[[species]]" in resolved and "name = 'small'" in resolved and "inertia" in resolved
     gsd_hoomd = pytest.importorskip("gsd.hoomd")
