@@ -102,6 +102,22 @@ class LogTable {
   std::ofstream out_;
 };
 
+// The bodies of species a (same order), for the per-species correlations of a mixture.
+State species_subset(const State& s, std::size_t a) {
+  std::vector<std::size_t> idx;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    if (s.species[i] == a) idx.push_back(i);
+  State out;
+  out.resize(idx.size());
+  for (std::size_t k = 0; k < idx.size(); ++k) {
+    const std::size_t i = idx[k];
+    out.r[k] = s.r[i], out.v[k] = s.v[i], out.q[k] = s.q[i], out.w[k] = s.w[i];
+    out.t[k] = s.t[i], out.count[k] = s.count[i], out.image[k] = s.image[i];
+    out.species[k] = s.species[i], out.scale[k] = s.scale[i];
+  }
+  return out;
+}
+
 // Keeps the first `frames` frames of a trajectory (after a resume from an older checkpoint).
 void truncate_trajectory(const std::string& path, std::uint64_t frames) {
   const gsd::Reader r(path);
@@ -135,6 +151,9 @@ class Driver {
         extra_(std::move(extra)),
         corr_(correlation_spec(cfg)), rdf_(rdf_spec(cfg)),
         gr_partial_(cfg.species.size(), int(cfg.gr_bins)) {
+    if (partial_gr()) corr_species_.assign(cfg.species.size(), TimeCorrelations(correlation_spec(cfg)));
+    for (std::size_t a = 0; a < std::min(corr_species_.size(), st_.corr_species.size()); ++a)
+      if (!st_.corr_species[a].empty()) corr_species_[a].load(st_.corr_species[a]);
     if (!st_.pressure.empty()) pressure_.load(st_.pressure);
     if (!st_.corr.empty()) corr_.load(st_.corr);
     if (!st_.gr.empty()) rdf_.load(st_.gr);
@@ -262,6 +281,8 @@ class Driver {
     st_.gr = rdf_.save();
     st_.nematic = nem_.save();
     if (partial_gr()) st_.gr_partial = gr_partial_.save();
+    st_.corr_species.clear();
+    for (const auto& c : corr_species_) st_.corr_species.push_back(c.save());
     if (st_.phase == 1) {
       const double c = cpu_seconds(), w = progress_.wall_seconds();
       st_.cpu_prev += c - cpu_mark_;
@@ -282,6 +303,8 @@ class Driver {
     const State s = synchronized_state(sim_);
     if (corr) {
       corr_.sample(sim_.now(), s, sim_.box());
+      for (std::size_t a = 0; a < corr_species_.size(); ++a)
+        corr_species_[a].sample(sim_.now(), species_subset(s, a), sim_.box());
       st_.next_corr += cfg_.obs_interval;
     }
     if (gr) {
@@ -434,6 +457,11 @@ class Driver {
         j["diffusion_fit_range"] = {fit.t_from, fit.t_to};
       }
       write_file_atomic(dir_ + "/correlations.tsv", corr_.to_tsv());
+      for (std::size_t a = 0; a < corr_species_.size(); ++a) {
+        const auto fa = corr_species_[a].diffusion();
+        if (fa.points > 0) j["species"][a]["diffusion_coefficient"] = fa.D;
+        write_file_atomic(dir_ + "/correlations_" + cfg_.species[a].name + ".tsv", corr_species_[a].to_tsv());
+      }
     }
     if (cfg_.gr_interval > 0.0) write_file_atomic(dir_ + "/gr.tsv", rdf_.to_tsv());
     if (cfg_.gr_interval > 0.0 && partial_gr()) {
@@ -465,6 +493,7 @@ class Driver {
   TimeCorrelations corr_;
   RadialDistribution rdf_;
   PartialRadialDistribution gr_partial_;  // mixtures: g_ab(r)
+  std::vector<TimeCorrelations> corr_species_;  // mixtures: MSD, C2, F_self per species
   NematicOrder nem_;
   Progress progress_;
   double cpu_mark_ = 0.0, wall_mark_ = 0.0, last_checkpoint_ = 0.0;

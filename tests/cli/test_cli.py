@@ -314,6 +314,8 @@ def test_mixture_outputs_name_the_species(tmp_path):
     assert {(p["a"], p["b"]) for p in s["species_pairs"]} == {
         ("big", "big"), ("big", "small"), ("small", "big"), ("small", "small")}
     assert s["init"]["method"] == "grow"
+    for name in ["big", "small"]:  # MSD, C2, F_self per species
+        assert (tmp_path / "o" / f"correlations_{name}.tsv").read_text().count("\n") > 5
     gp = (tmp_path / "o" / "gr_partial.tsv").read_text().splitlines()
     assert "r\tg_big_big\tg_big_small\tg_small_small" in gp
     r = run(["plot", "o"], tmp_path)

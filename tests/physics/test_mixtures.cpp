@@ -69,7 +69,7 @@ class BinaryHardSpheres : public ::testing::TestWithParam<BinaryPoint> {};
 
 TEST_P(BinaryHardSpheres, PressureAndPartialCollisionRatesMatchBmcsl) {
   const auto [phi, time] = GetParam();
-  const auto s = run_config("binary", binary_config(phi, 0.5, 1.0, 10.0, time));
+  const auto s = run_config("binary-" + std::to_string(int(100 * phi)), binary_config(phi, 0.5, 1.0, 10.0, time));
   const Bmcsl ref = bmcsl({0.5, 0.5}, {1.0, 0.5}, {1.0, 1.0}, phi);
   const double z = s["Z"], ze = s["Z_error"];
   std::printf("binary d_B/d_A = 0.5, phi = %.2f: Z = %.4f +- %.4f, BMCSL %.4f (%+.2f %%, %.1f sigma), %llu collisions\n",
