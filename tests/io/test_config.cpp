@@ -74,6 +74,16 @@ struct BadCase {
   const char* expect;  // substring of the message
 };
 
+// Each case's config fails with a message containing its `expect`.
+template <std::size_t N>
+void expect_messages(const BadCase (&cases)[N]) {
+  for (const auto& c : cases) {
+    const std::string msg = error_of(c.text);
+    EXPECT_NE(msg.find(c.expect), std::string::npos)
+        << c.what << ": got message '" << msg << "', expected to contain '" << c.expect << "'";
+  }
+}
+
 TEST(Config, BadInputNamesTheProblem) {
   const std::string g = kGood;
   const BadCase cases[] = {
@@ -104,11 +114,7 @@ TEST(Config, BadInputNamesTheProblem) {
        replace(g, "type = \"sphere\"\nradius = 0.5", "type = \"ellipsoid\"\nsemi_axes = [1, -1, 1]"),
        "shape.semi_axes"},
   };
-  for (const auto& c : cases) {
-    const std::string msg = error_of(c.text);
-    EXPECT_NE(msg.find(c.expect), std::string::npos)
-        << c.what << ": got message '" << msg << "', expected to contain '" << c.expect << "'";
-  }
+  expect_messages(cases);
 }
 
 TEST(Config, MissingFileIsAConfigError) {
@@ -212,11 +218,7 @@ TEST(Config, BadSpeciesNameTheKey) {
       {"particles and species", replace(m, "packing_fraction = 0.3", "packing_fraction = 0.3\nparticles = 150"),
        "key 'system.particles': is set per species"},
   };
-  for (const auto& c : cases) {
-    const std::string msg = error_of(c.text);
-    EXPECT_NE(msg.find(c.expect), std::string::npos)
-        << c.what << ": got message '" << msg << "', expected to contain '" << c.expect << "'";
-  }
+  expect_messages(cases);
 }
 
 // docs/config.md is generated from the schema: it lists every key, and it is up to date.
