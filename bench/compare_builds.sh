@@ -4,9 +4,12 @@
 # machine is shared and noisy. Two state points:
 #   hard spheres   N = 32000, phi = 0.45, cell lists (bench_hard_spheres), CPU ns per collision
 #   ellipsoids     X0 = 2, phi = 0.5, N = 256, NNL (bench_rigid), CPU us per collision
-# Usage: bench/compare_builds.sh OLD_COMMIT [ROUNDS=5]
+# Usage: bench/compare_builds.sh OLD_COMMIT [ROUNDS=5] [instructions]
 # The old commit is built in a detached worktree under ${TMPDIR:-/tmp}; the current tree must be
 # built (make build). Prints one JSON line per run and a summary (medians, new/old ratios).
+# With `instructions`, each build also runs once under valgrind's callgrind (smaller workloads:
+# 3x10^5 sphere and 3000 ellipsoid collisions, whole process): instruction counts do not depend
+# on the load of the machine, so their ratio resolves differences far below the timing noise.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 old=${1:?usage: bench/compare_builds.sh OLD_COMMIT [ROUNDS]}
@@ -47,3 +50,22 @@ for point in ["spheres", "ellipsoids"]:
                       "ratio_per_round": [round(x, 4) for x in pairs]}))
 PY
 rm -f "$log"
+if [ "${3:-}" = "instructions" ]; then
+  echo; echo "instructions (callgrind, whole process):"
+  for point in spheres ellipsoids; do
+    for build in old new; do
+      hs=${build}_hs rb=${build}_rb
+      out=$(mktemp)
+      if [ $point = spheres ]; then
+        valgrind --tool=callgrind --callgrind-out-file="$out" "${!hs}" 32000 0.45 3e5 1e5 >/dev/null 2>&1
+      else
+        valgrind --tool=callgrind --callgrind-out-file="$out" "${!rb}" shape=ellipsoid N=256 phi=0.5 X0=2 \
+          method=nnl collisions=3000 warmup=1000 check=0 >/dev/null 2>&1
+      fi
+      eval "ir_$build=$(sed -n 's/^summary: //p' "$out")"
+      rm -f "$out"
+    done
+    /usr/bin/python3 -c "import json,sys; o,n=int(sys.argv[2]),int(sys.argv[3]); print(json.dumps({'point': sys.argv[1], 'old_instructions': o, 'new_instructions': n, 'ratio_new_over_old': n / o}))" \
+      "$point" "$ir_old" "$ir_new"
+  done
+fi
