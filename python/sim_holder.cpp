@@ -68,6 +68,7 @@ std::unique_ptr<SimHandle> build(const Config& c, const Box* box, const State* s
     throw ConfigError(fmt::format("{}: key 'system.packing_fraction': {} ({} particles at {})",
                                   c.source, e.what(), c.particles, c.packing_fraction));
   }
+  if (!h) throw std::logic_error("the builder assembled no simulation for this config");
   return h;
 }
 
@@ -79,6 +80,18 @@ std::unique_ptr<SimHandle> make_simulation(const Config& c, const Box& box, cons
   if (start.size() != c.particles)
     throw ConfigError(fmt::format("{}: key 'system.particles': {} in the config, {} bodies given",
                                   c.source, c.particles, start.size()));
+  // the bodies' species (GSD typeid) must be the config's, count for count
+  std::vector<std::uint64_t> counts(c.species.size(), 0);
+  for (std::size_t i = 0; i < start.size(); ++i) {
+    if (start.species[i] >= c.species.size())
+      throw ConfigError(fmt::format("{}: key 'species': body {} has type id {}, the config has {} species",
+                                    c.source, i, start.species[i], c.species.size()));
+    ++counts[start.species[i]];
+  }
+  for (std::size_t a = 0; a < counts.size(); ++a)
+    if (counts[a] != c.species[a].count)
+      throw ConfigError(fmt::format("{}: key 'species': {} bodies of species '{}' given, the config has {}",
+                                    c.source, counts[a], c.species[a].name, c.species[a].count));
   auto h = build(c, &box, &start);
   const OverlapReport rep = h->overlaps();
   if (rep.overlaps > 0)

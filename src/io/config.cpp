@@ -217,6 +217,7 @@ constexpr double kMixtureStartLimit = 0.6;
 SpeciesTable read_species(const Reader& r, const toml::array& arr) {
   SpeciesTable out;
   if (arr.empty()) r.fail(&arr, "species", "must list at least one species");
+  if (arr.size() > 65535) r.fail(&arr, "species", "at most 65535 species (a body's species id is 16 bits)");
   for (std::size_t k = 0; k < arr.size(); ++k) {
     const std::string prefix = fmt::format("species[{}].", k);
     const auto* t = arr.get(k)->as_table();
@@ -235,8 +236,10 @@ SpeciesTable read_species(const Reader& r, const toml::array& arr) {
     if (!name) throw ConfigError(fmt::format("{}: missing key '{}'", where(r.file, *t), key("name")));
     if (auto v = name->value_exact<std::string>()) sp.name = *v;
     else r.fail(name, key("name"), "must be a string");
-    if (sp.name.empty() || sp.name.find_first_of(" \t\n\"") != std::string::npos)
-      r.fail(name, key("name"), "must be a non-empty word (it is the GSD type name)");
+    if (sp.name.empty() || sp.name.size() > 64 ||
+        sp.name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_+-") != std::string::npos)
+      r.fail(name, key("name"), "must be a word of letters, digits, '_', '+' or '-' (at most 64; it is the "
+                                "GSD type name and part of file names)");
     for (std::size_t j = 0; j < out.size(); ++j)
       if (out[j].name == sp.name)
         r.fail(name, key("name"), fmt::format("duplicate species name '{}' (also species[{}])", sp.name, j));
@@ -336,6 +339,9 @@ void apply_override(toml::table& root, const std::string& ov) {
       throw ConfigError(fmt::format("--set '{}': cannot parse value: {}", ov, e.description()));
     }
   }
+  if (root.contains(sec) && !root.get_as<toml::table>(sec))
+    throw ConfigError(fmt::format("--set '{}': '{}' is not a table of keys ([[species]] entries cannot be "
+                                  "set with --set; edit the config file)", ov, sec));
   auto* t = root.get_as<toml::table>(sec);
   if (!t) {
     root.insert(sec, toml::table{});
@@ -608,7 +614,7 @@ std::string config_reference() {
   });
   out += "\n## [[species]] (a mixture; replaces [shape], system.particles and system.mass)\n\n"
          "| key | type | default | meaning |\n|---|---|---|---|\n"
-         "| `name` | string | required | GSD type name; unique |\n"
+         "| `name` | string | required | GSD type name and part of file names: unique, letters, digits, _ + - (at most 64) |\n"
          "| `count` | integer | required | bodies of this species (>= 1) |\n"
          "| `shape` | table | required | `{ type = ..., ... }` as [shape] above |\n"
          "| `mass` | number | 1 | body mass at scale 1 |\n"

@@ -226,6 +226,9 @@ void assemble(const Config& c, F&& f) {
   bool spheres = true;
   for (const Species& sp : c.species) spheres = spheres && std::holds_alternative<Sphere>(sp.shape);
   if (spheres) return builder_detail::assemble_spheres(c, f);
+  if (c.mixture())  // (before the visit: a mixture led by a sphere would match no rigid branch)
+    throw ConfigError(fmt::format("{}: key 'species': mixtures and polydispersity of non-spherical "
+                                  "bodies are not supported yet (spheres only)", c.source));
   std::visit(
       [&](const auto& shape) {
         if constexpr (!std::is_same_v<std::decay_t<decltype(shape)>, Sphere>)

@@ -165,6 +165,12 @@ time = 1.0
 )";
 }  // namespace
 
+// --set on a key of [[species]] (an array of tables) is refused with a message, not a crash.
+TEST(Config, SetCannotReachIntoSpecies) {
+  EXPECT_NE(error_of(kMixture, {"species.count=3"}).find("--set 'species.count=3': 'species' is not a table"),
+            std::string::npos);
+}
+
 TEST(Config, SpeciesTableParsesAndRoundTrips) {
   const Config c = parse_config(kMixture, "mix.toml");
   ASSERT_EQ(c.species.size(), 2u);
@@ -217,6 +223,8 @@ TEST(Config, BadSpeciesNameTheKey) {
       {"shape and species", m + "[shape]\ntype = \"sphere\"\nradius = 0.5\n", "[shape] and [[species]] exclude each other"},
       {"particles and species", replace(m, "packing_fraction = 0.3", "packing_fraction = 0.3\nparticles = 150"),
        "key 'system.particles': is set per species"},
+      {"name with a slash", replace(m, "name = \"B\"", "name = \"B/x\""), "key 'species[1].name': must be a word"},
+      {"name ..", replace(m, "name = \"B\"", "name = \"..\""), "key 'species[1].name': must be a word"},
   };
   expect_messages(cases);
 }

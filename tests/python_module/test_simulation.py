@@ -263,6 +263,12 @@ def test_from_gsd_continues_from_a_trajectory_frame(tmp_path):
                                      dict(cfg, system=dict(cfg["system"], particles=100)))
     with pytest.raises(ValueError):
         hardbody.Simulation.from_gsd(str(tmp_path / "nothing.gsd"), cfg)
+    # the frame's species (typeid) must be the config's, count for count
+    mix = {"system": {"packing_fraction": 0.3, "seed": 5},
+           "species": [{"name": "A", "count": 54, "shape": {"type": "sphere", "radius": 0.5}},
+                       {"name": "B", "count": 54, "shape": {"type": "sphere", "radius": 0.5}}]}
+    with pytest.raises(ValueError, match="species 'A' given, the config has 54"):
+        hardbody.Simulation.from_gsd(str(tmp_path / "o" / "trajectory.gsd"), mix)
 
 
 def test_correlations_from_python_ballistic_start():
@@ -296,3 +302,7 @@ def test_sphere_mixture_from_dict():
     assert abs(sim.kinetic_energy() / e0 - 1.0) < 1e-12
     with pytest.raises(ValueError, match=r"species\[1\]\.count"):
         hardbody.Simulation(dict(cfg, species=[cfg["species"][0], dict(cfg["species"][1], count=0)]))
+    # a sphere first, then an ellipsoid: refused (it once built nothing and crashed)
+    with pytest.raises(ValueError, match="non-spherical"):
+        hardbody.Simulation(dict(cfg, species=[cfg["species"][0], dict(
+            cfg["species"][1], shape={"type": "ellipsoid", "semi_axes": [1.0, 0.5, 0.5]})]))

@@ -119,3 +119,25 @@ TEST(Builder, GeometryChecksNameTheKey) {
   c.init_phi0 = 0.2;
   EXPECT_EQ(error_of(c), "");  // grown instead: the dilute lattice holds 0.2
 }
+
+// A mixture of a sphere and a non-spherical body is refused whichever species comes first (with a
+// sphere first it once matched no branch and built nothing).
+TEST(Builder, NonSphericalMixturesAreRefusedInAnyOrder) {
+  for (int sphere_first = 0; sphere_first < 2; ++sphere_first) {
+    Config c = config(Sphere{0.5}, 100, 0.2, "cells");
+    Species e{"E", 100, Ellipsoid{1.0, 0.5, 0.5}, 1.0, Vec3::Constant(0.1), {}};
+    if (sphere_first) c.species.push_back(e);
+    else c.species.insert(c.species.begin(), e);
+    c.species_given = true;
+    c.particles = 200;
+    bool called = false;
+    try {
+      assemble(c, [&](const auto&) { called = true; });
+      ADD_FAILURE() << "no error (sphere first: " << sphere_first << ")";
+    } catch (const ConfigError& err) {
+      EXPECT_NE(std::string(err.what()).find("key 'species': mixtures and polydispersity of non-spherical"),
+                std::string::npos) << err.what();
+    }
+    EXPECT_FALSE(called);
+  }
+}
