@@ -10,6 +10,7 @@
 #pragma once
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "math/types.hpp"
@@ -47,6 +48,13 @@ inline std::uint64_t total_count(const SpeciesTable& t) {
   std::uint64_t n = 0;
   for (const Species& s : t) n += s.count;
   return n;
+}
+
+// Index of the unordered species pair {a, b} among the ns (ns + 1) / 2 pairs a <= b, listed row
+// by row (0-0, 0-1, ..., 0-(ns-1), 1-1, ...): the layout of every per-pair table of a run.
+inline std::size_t species_pair_index(std::size_t a, std::size_t b, std::size_t ns) {
+  if (a > b) std::swap(a, b);
+  return a * ns - a * (a - 1) / 2 + (b - a);
 }
 
 }  // namespace hb

@@ -20,8 +20,6 @@
 #include "io/progress.hpp"
 #include "io/shape_io.hpp"
 #include "observers/correlations.hpp"
-#include "observers/overlap.hpp"
-#include "observers/overlap_sampling.hpp"
 #include "observers/structure.hpp"
 #include "observers/thermo.hpp"
 #include "setup/builder.hpp"
@@ -324,9 +322,7 @@ class Driver {
   double temperature() const { return ops_.temperature(sim_.state()); }
   // index of the species pair (a <= b) in st_.pair_collisions
   std::size_t pair_index(std::size_t a, std::size_t b) const {
-    if (a > b) std::swap(a, b);
-    const std::size_t ns = cfg_.species.size();
-    return a * ns - a * (a - 1) / 2 + (b - a);
+    return species_pair_index(a, b, cfg_.species.size());
   }
   void count_pair(const CollisionRecord& r) {
     const State& s = sim_.state();

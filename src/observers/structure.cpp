@@ -212,8 +212,7 @@ PartialRadialDistribution::PartialRadialDistribution(std::size_t species, int bi
 }
 
 std::size_t PartialRadialDistribution::pair_index(std::size_t a, std::size_t b) const {
-  if (a > b) std::swap(a, b);
-  return a * ns_ - a * (a - 1) / 2 + (b - a);
+  return species_pair_index(a, b, ns_);
 }
 
 void PartialRadialDistribution::sample(double time, const State& state, const Box& box, double r_max) {

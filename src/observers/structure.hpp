@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/species.hpp"
 #include "math/types.hpp"
 #include "observers/block_average.hpp"
 #include "system/box.hpp"
