@@ -58,7 +58,7 @@ int main(int argc, char** argv) {
   spec.eps_d = argc > 8 ? std::atof(argv[8]) : 1e-5;
   // the paper's convention: b = c = 0.5 (unit minor diameter), a = X0 b
   spec.semi_axes = Vec3(0.5 * x0, 0.5, 0.5);
-  spec.inertia = 0.4 * spec.mass * std::pow(spec.semi_axes.minCoeff(), 2);
+  spec.inertia = Vec3::Constant(0.4 * spec.mass * std::pow(spec.semi_axes.minCoeff(), 2));
   if (std::strcmp(method, "cells") == 0)
     return bench(make_ellipsoid_cell_simulation(spec), spec, x0, method, coll, warm, shell);
   return bench(make_ellipsoid_list_simulation(spec, shell), spec, x0, method, coll, warm, shell);

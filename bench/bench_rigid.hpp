@@ -86,7 +86,7 @@ inline RigidPoint read_point(Args& a) {
   pt.p = a.num("p", 2.0);
   pt.spec.semi_axes = Vec3(pt.x0 * b, b, b);
   pt.spec.exponents = Vec3(2.0, 2.0, pt.p);
-  pt.spec.inertia = a.num("inertia", 0.4 * pt.spec.mass * hb::sqr(pt.spec.semi_axes.minCoeff()));
+  pt.spec.inertia = Vec3::Constant(a.num("inertia", 0.4 * pt.spec.mass * hb::sqr(pt.spec.semi_axes.minCoeff())));
   pt.spec.eps_d = a.num("eps_d", 1e-5);
   pt.spec.seed = static_cast<std::uint64_t>(a.num("seed", 1));
   pt.shell = a.num("shell", 0.15);
@@ -272,7 +272,7 @@ inline hb::Config config_of(const RigidPoint& pt) {
   if (pt.shape == "ellipsoid") sp.shape = hb::Ellipsoid{a.x(), a.y(), a.z()};
   else sp.shape = hb::Superquadric{a.x(), a.y(), a.z(), e.x(), e.y(), e.z()};
   sp.name = std::string(hb::shape_name(sp.shape));
-  sp.inertia = Vec3::Constant(pt.spec.inertia);
+  sp.inertia = pt.spec.inertia;
   c.eps_d = pt.spec.eps_d;
   c.neighbors_method = pt.method;
   c.shell = pt.shell;
@@ -296,7 +296,7 @@ inline hb::Config sphere_config(std::size_t n, double phi, double shell, std::ui
 template <class F>
 void with_rigid_assembly(const hb::Config& c, F&& f) {
   hb::assemble(c, [&](const auto& as) {
-    if constexpr (requires { as.model().shape; }) f(as);
+    if constexpr (requires { as.model().shape.bounding_radius(); }) f(as);  // one species
     else throw std::invalid_argument("not a rigid-body point");
   });
 }
@@ -336,7 +336,7 @@ inline Json describe(const RigidPoint& pt) {
   j["p"] = pt.p;
   j["semi_axes"] = {pt.spec.semi_axes.x(), pt.spec.semi_axes.y(), pt.spec.semi_axes.z()};
   j["exponents"] = {pt.spec.exponents.x(), pt.spec.exponents.y(), pt.spec.exponents.z()};
-  j["inertia"] = pt.spec.inertia;
+  j["inertia"] = pt.spec.inertia.x();
   j["method"] = pt.method;
   j["shell"] = pt.shell;
   j["eps_d"] = pt.spec.eps_d;

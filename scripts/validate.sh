@@ -14,6 +14,9 @@
 #                   -> docs/validation/superquadrics.md       (issue 5)
 #   sq-taus         one short superquadric run per p (X0 = 2, NNL) to measure tau_c first
 #   sq-vs-ellipsoid ellipsoid vs superquadric [2, 2, 2] at the superquadric state point (Z)
+#   tops            10^6 collisions of N = 256 triaxial ellipsoids [1.5, 1, 0.6] (asymmetric tops,
+#                   uniform-density inertia) at phi = 0.40, NNL -> docs/validation/runs/tops.summary.json
+#                   (issue 11: per-axis rotational temperatures, energy drift)
 #   tables          only rebuild the .md tables from the stored summaries
 #   `scripts/validate.sh 1000000` (a number first) is the old form: the ellipsoids group.
 # Environment: HB (binary, default build/apps/hardbody/hardbody), WORK (run directories, default
@@ -172,6 +175,19 @@ case "$group" in
             "$work/sqe_el_X0_$x0$sfx.toml" && run "sqe_el_X0_$x0$sfx"
       done
     done ;;
+  tops)
+    # issue 11: asymmetric tops (triaxial [1.5, 1, 0.6], uniform-density inertia) at phi = 0.40:
+    # equipartition over the principal axes, energy drift over 10^6 collisions, no overlap
+    { cat <<TOML
+[system]
+packing_fraction = 0.40
+seed = 3
+[[species]]
+name = "T"
+count = 256
+shape = { type = "ellipsoid", semi_axes = [1.5, 1.0, 0.6] }
+TOML
+      sections nnl 2.0 50.0; } > "$work/tops.toml" && run tops ;;
   tables) ;;
   *) echo "unknown group '$group' (ellipsoids, ellipsoids-045, superquadrics, sq-taus, sq-vs-ellipsoid, tables)" >&2
      exit 2 ;;

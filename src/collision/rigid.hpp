@@ -84,6 +84,14 @@ struct MassProperties {
     return p;
   }
 
+  // Principal moments I along the body x, y, z axes: a spherical top when all three are equal.
+  static MassProperties principal(double m, const Vec3& I) {
+    if (I[0] == I[1] && I[1] == I[2]) return spherical_top(m, I[0]);
+    return from_tensor(m, Mat3(I.asDiagonal()));
+  }
+  // The principal moments that govern the free rotation (BodyState::top): 0 for a spherical top.
+  Vec3 top() const { return spherical ? Vec3::Zero() : Vec3(inertia_body.diagonal()); }
+
   // I_lab^-1 x for a body with orientation q (body -> lab).
   Vec3 apply_inv_inertia(const Quat& q, const Vec3& x) const {
     if (spherical) return inv_scalar_inertia * x;
@@ -159,6 +167,7 @@ inline CollisionRecord collide(BodyState& A, const MassProperties& mA, BodyState
   B.v += (J * mB.inv_mass) * n;
   A.w -= J * dwA;
   B.w += J * dwB;
+  A.rot = B.rot = nullptr;  // a new free rotation
 
   // Exact energy change of this impulse: -J (u.n + u'.n)/2, with u' from the updated states.
   const Vec3 u_after = (A.v + A.w.cross(rA)) - (B.v + B.w.cross(rB));

@@ -22,6 +22,10 @@
 // M; others (superquadrics with an exponent > 2: flat faces, rho unbounded) only K_n.
 // Evaluation: R(t)^T n = R(t_state)^T rot(w, -|w| tau) n (Rodrigues on one vector, tau =
 // t - t_state): two sin/cos and two support functions per value.
+// Tops that are not spherical (W(t) varies; motion/motion.hpp): m' = -W x m still, so
+// |m'| <= max |w| replaces |w x n| in K_n; and m'' = -W' x m - W x m', |m''| <= max |W'| +
+// max |w|^2 (Motion::max_angular_acceleration bounds |W'| from Euler's equations), so each body
+// adds rho wmax^2 + L (wmax^2 + max |W'|) to M. R(t) and W(t) come from the Motion.
 // Growth (both shapes scaled about their centres by s(t) = s0 + sdot tau, contact_time.hpp):
 // the support functions scale, g = n.(r_B - r_A) - s(t) (h_A + h_B), so
 //     g' = n.dv - sdot (h_A + h_B) + s(t) (p_A.(W_A x m_A) + p_B.(W_B x m_B)),
@@ -34,6 +38,7 @@
 
 #include "math/types.hpp"
 #include "motion/free_flight.hpp"
+#include "motion/motion.hpp"
 #include "shapes/shape.hpp"
 
 namespace hb {
@@ -54,20 +59,28 @@ class AxisGap {
   }
 
   // s0, sdot: the common scale law of both shapes (growth); s0 = 1, sdot = 0 for rigid bodies.
-  AxisGap(const SA& sa, const BodyState& a, const SB& sb, const BodyState& b, double t_state,
+  // The motions are referenced, not copied: they must outlive the AxisGap.
+  AxisGap(const SA& sa, const Motion& ma, const SB& sb, const Motion& mb, double t_state,
           const Vec3& n, double s0 = 1.0, double sdot = 0.0)
-      : sa_(sa), sb_(sb), n_(n), dr_(b.r - a.r), dv_(b.v - a.v), t_state_(t_state), s0_(s0),
-        sdot_(sdot), curved_(curved(sa, sb)) {
+      : sa_(sa), sb_(sb), ma_(&ma), mb_(&mb), n_(n), dr_(mb.initial().r - ma.initial().r),
+        dv_(mb.initial().v - ma.initial().v), t_state_(t_state), s0_(s0), sdot_(sdot),
+        curved_(curved(sa, sb)) {
+    const BodyState& a = ma.initial();
+    const BodyState& b = mb.initial();
     const double La = sa.bounding_radius(), Lb = sb.bounding_radius();
-    const double swa = a.w.cross(n).norm(), swb = b.w.cross(n).norm();
+    const double swa = ma.spherical() ? a.w.cross(n).norm() : ma.max_angular_speed();
+    const double swb = mb.spherical() ? b.w.cross(n).norm() : mb.max_angular_speed();
     wa_ = a.w.norm(), wb_ = b.w.norm();
     ndv_ = std::abs(n.dot(dv_));
     rot_ = La * swa + Lb * swb;
     Lsum_ = La + Lb;
+    // bounds of |m''| per body: |w| |w x n| for a spherical top (m turns about a fixed axis)
+    const double mdd_a = ma.spherical() ? wa_ * swa : swa * swa + ma.max_angular_acceleration();
+    const double mdd_b = mb.spherical() ? wb_ * swb : swb * swb + mb.max_angular_acceleration();
     if constexpr (kMayCurve)
       if (curved_)
-        Mrigid_ = swa * (sa.max_curvature_radius() * swa + La * wa_) +
-                swb * (sb.max_curvature_radius() * swb + Lb * wb_);
+        Mrigid_ = swa * swa * sa.max_curvature_radius() + La * mdd_a +
+                  swb * swb * sb.max_curvature_radius() + Lb * mdd_b;
     bounds(s0);
     RaT_ = a.q.toRotationMatrix().transpose();
     RbT_ = b.q.toRotationMatrix().transpose();
@@ -91,13 +104,30 @@ class AxisGap {
   // (their support points are the extreme points along the axis).
   double value(double t, double& slope, Vec3& ma, Vec3& mb) const {
     const double tau = t - t_state_;
-    ma = RaT_ * back(ka_, wa_, tau);
-    mb = -(RbT_ * back(kb_, wb_, tau));
+    Vec3 Wa = Wa_, Wb = Wb_;  // body-frame angular velocities at t
+    if (ma_->spherical()) {
+      ma = RaT_ * back(ka_, wa_, tau);
+    } else {
+      Quat q;
+      Vec3 w;
+      ma_->pose(tau, q, w);
+      const Mat3 RT = q.toRotationMatrix().transpose();
+      ma = RT * n_, Wa = RT * w;
+    }
+    if (mb_->spherical()) {
+      mb = -(RbT_ * back(kb_, wb_, tau));
+    } else {
+      Quat q;
+      Vec3 w;
+      mb_->pose(tau, q, w);
+      const Mat3 RT = q.toRotationMatrix().transpose();
+      mb = -(RT * n_), Wb = RT * w;
+    }
     const double sc = s0_ + sdot_ * tau;
     if (curved_) {
       const Vec3 pa = sa_.support_point(ma), pb = sb_.support_point(mb);
       const double h = pa.dot(ma) + pb.dot(mb);
-      slope = n_.dot(dv_) - sdot_ * h + sc * (pa.dot(Wa_.cross(ma)) + pb.dot(Wb_.cross(mb)));
+      slope = n_.dot(dv_) - sdot_ * h + sc * (pa.dot(Wa.cross(ma)) + pb.dot(Wb.cross(mb)));
       return n_.dot(dr_ + dv_ * tau) - sc * h;
     } else {
       slope = -Kn;
@@ -120,6 +150,8 @@ class AxisGap {
 
   const SA& sa_;
   const SB& sb_;
+  const Motion* ma_;
+  const Motion* mb_;
   Vec3 n_, dr_, dv_;
   double t_state_, s0_, sdot_;
   bool curved_;
@@ -139,13 +171,12 @@ class AxisGap {
 // iteration; the search stops early once the gap reaches `enough`); `scale` scales both shapes
 // (growth). Zero vector if the centres coincide.
 template <SupportShape SA, SupportShape SB>
-Vec3 separating_axis(const SA& sa, const BodyState& a, const SB& sb, const BodyState& b,
-                     double tau, int iterations, double& gap, double enough = kInf,
-                     double scale = 1.0) {
-  const Vec3 c = (b.r - a.r) + (b.v - a.v) * tau;
+Vec3 separating_axis(const SA& sa, const Motion& a, const SB& sb, const Motion& b, double tau,
+                     int iterations, double& gap, double enough = kInf, double scale = 1.0) {
+  const Vec3 c = (b.initial().r - a.initial().r) + (b.initial().v - a.initial().v) * tau;
   gap = -kInf;
   if (!(c.squaredNorm() > 0.0)) return Vec3::Zero();
-  const Mat3 Ra = rotation_at(a, tau), Rb = rotation_at(b, tau);
+  const Mat3 Ra = a.rotation(tau), Rb = b.rotation(tau);
   double beta = c.norm() + 0.5 * scale * (sa.bounding_radius() + sb.bounding_radius());
   auto eval = [&](const Vec3& n, Vec3& sep) {
     const Vec3 xa = scale * (Ra * sa.support_point(Vec3(Ra.transpose() * n)));

@@ -10,6 +10,8 @@
 //     possible: |r_AB(t)| <= L_A + L_B.  Empty window: `none`, without any distance solve.
 //  2. Stepping with the distance-rate bound (Eq. distOver)
 //        |d'(t)| <= K = |v_B - v_A| + |w_A| L_A + |w_B| L_B :
+//     (for a top that is not spherical w changes along the flight: |w| is replaced by its
+//     maximum over the flight, Motion::max_angular_speed; motion/motion.hpp)
 //     from t with distance d, no contact is possible before t + d / K.  Step
 //     dt = max(d, eps_d) / K (the paper's rule).  Each step evaluates the distance (warm-started
 //     from the previous solution of the pair) and its rate d' = n.(u_B(x_B) - u_A(x_A)), u the
@@ -86,6 +88,7 @@
 #include "math/brent.hpp"
 #include "math/types.hpp"
 #include "motion/free_flight.hpp"
+#include "motion/motion.hpp"
 #include "shapes/shape.hpp"
 
 namespace hb {
@@ -162,8 +165,9 @@ struct ContactResult {
   DistanceWarmStart warm;       // last distance solution (warm start for the next prediction)
 };
 
-// A body in free flight, coordinates relative to `origin` (to keep the numbers small),
-// optionally scaled about its centre by s(t) = s0 + sdot (t - t_state).
+// A body in free flight (any top: motion/motion.hpp), coordinates relative to `origin` (to keep
+// the numbers small), optionally scaled about its centre by s(t) = s0 + sdot (t - t_state): the
+// growth decorator on top of the Motion.
 template <Shape S>
 struct MovingBody {
   const S* shape;
@@ -172,30 +176,47 @@ struct MovingBody {
   Vec3 origin;
   double s0 = 1.0;    // scale at t_state
   double sdot = 0.0;  // ds/dt
+  Motion motion;
+
+  MovingBody(const S* sh, const BodyState& b, double ts, const Vec3& o, double s0_ = 1.0,
+             double sdot_ = 0.0)
+      : shape(sh), st(b), t_state(ts), origin(o), s0(s0_), sdot(sdot_), motion(b) {}
 
   double scale_at(double t) const { return s0 + sdot * (t - t_state); }
   Pose pose_at(double t) const {
-    return Pose{st.r - origin + st.v * (t - t_state), rotation_at(st, t - t_state)};
+    return Pose{st.r - origin + st.v * (t - t_state), motion.rotation(t - t_state)};
   }
-  // Velocity of the surface point at frame point x (rigid motion + growth), pose p at time t.
-  Vec3 point_velocity(const Vec3& x, const Pose& p, double t) const {
+  // The pose and the angular velocity w at time t (one evaluation of the free rotation).
+  Pose pose_at(double t, Vec3& w) const {
+    Quat q;
+    motion.pose(t - t_state, q, w);
+    return Pose{st.r - origin + st.v * (t - t_state), q.toRotationMatrix()};
+  }
+  // Velocity of the surface point at frame point x (rigid motion + growth), pose p and angular
+  // velocity w at time t.
+  Vec3 point_velocity(const Vec3& x, const Pose& p, double t, const Vec3& w) const {
     const Vec3 rel = x - p.r;
-    if (sdot == 0.0) return st.v + st.w.cross(rel);
-    return st.v + st.w.cross(rel) + (sdot / scale_at(t)) * rel;
+    if (sdot == 0.0) return st.v + w.cross(rel);
+    return st.v + w.cross(rel) + (sdot / scale_at(t)) * rel;
+  }
+  Vec3 point_velocity(const Vec3& x, const Pose& p, double t) const {
+    return point_velocity(x, p, t, motion.angular_velocity(t - t_state));
   }
   // f, grad f, Hessian and their time derivatives at the frame point x and time t (of the
-  // shape at scale s(t); see the header for the growth terms).
+  // shape at scale s(t); see the header for the growth terms). dR/dt = [w(t)]x R for any top,
+  // so the formulas hold with the instantaneous angular velocity.
   void eval(const Vec3& x, double t, double& f, Vec3& g, Mat3& H, double& ft, Vec3& gt) const {
-    const Pose p = pose_at(t);
+    Vec3 w;
+    const Pose p = pose_at(t, w);
     const Vec3 rel = x - p.r;
     const Vec3 y = p.R.transpose() * rel;
     if (sdot == 0.0 && s0 == 1.0) {
       f = shape->f(y);
       g = p.R * shape->grad(y);
       H = p.R * shape->hessian(y) * p.R.transpose();
-      const Vec3 u = st.v + st.w.cross(rel);
+      const Vec3 u = st.v + w.cross(rel);
       ft = -g.dot(u);
-      gt = st.w.cross(g) - H * u;
+      gt = w.cross(g) - H * u;
       return;
     }
     const double s = scale_at(t), gr = sdot / s;
@@ -203,9 +224,9 @@ struct MovingBody {
     f = shape->f(z);
     g = p.R * shape->grad(z) / s;
     H = p.R * shape->hessian(z) * p.R.transpose() / (s * s);
-    const Vec3 u = st.v + st.w.cross(rel) + gr * rel;
+    const Vec3 u = st.v + w.cross(rel) + gr * rel;
     ft = -g.dot(u);
-    gt = st.w.cross(g) - H * u - gr * g;
+    gt = w.cross(g) - H * u - gr * g;
   }
 };
 
@@ -238,15 +259,21 @@ void contact_system(const MovingBody<SA>& A, const MovingBody<SB>& B, const Vec5
   (*J)(4, 4) = ftb;
 }
 
-// Upper bound of |d'(t)| (Eq. distOver).
+// Upper bound of |d'(t)| (Eq. distOver) for spherical tops (|w| constant).
 inline double distance_rate_bound(const BodyState& a, double La, const BodyState& b, double Lb) {
   return (b.v - a.v).norm() + a.w.norm() * La + b.w.norm() * Lb;
 }
+// The same for any tops: |w(t)| <= max_angular_speed() (equal to |w| for spherical tops).
+inline double distance_rate_bound(const Motion& a, double La, const Motion& b, double Lb) {
+  return (b.initial().v - a.initial().v).norm() + a.max_angular_speed() * La +
+         b.max_angular_speed() * Lb;
+}
 
 // Upper bound of |d'| over [t0, t1] for bodies scaled by law s(t) (growth; see the header).
-inline double distance_rate_bound(const BodyState& a, double La, const BodyState& b, double Lb,
+inline double distance_rate_bound(const Motion& a, double La, const Motion& b, double Lb,
                                   double s_max, double sdot) {
-  return (b.v - a.v).norm() + (a.w.norm() * La + b.w.norm() * Lb) * s_max +
+  return (b.initial().v - a.initial().v).norm() +
+         (a.max_angular_speed() * La + b.max_angular_speed() * Lb) * s_max +
          std::abs(sdot) * (La + Lb);
 }
 
@@ -346,14 +373,14 @@ struct Solver {
         L(std::max(i.shape_a.bounding_radius(), i.shape_b.bounding_radius()) *
           (grow ? A.scale_at(i.t_start) : 1.0)),
         K(grow ? rate_bound(i.t_start, i.t_start)
-               : distance_rate_bound(i.a, i.shape_a.bounding_radius(), i.b,
+               : distance_rate_bound(A.motion, i.shape_a.bounding_radius(), B.motion,
                                      i.shape_b.bounding_radius())),
         warm(i.warm), warm_scale(grow ? A.scale_at(i.t_start) : 1.0) {}
 
   // Rate bound over [t0, t1] (growth: the scale is largest at one end).
   double rate_bound(double t0, double t1) const {
     if (!grow) return K;
-    return distance_rate_bound(in.a, in.shape_a.bounding_radius(), in.b,
+    return distance_rate_bound(A.motion, in.shape_a.bounding_radius(), B.motion,
                                in.shape_b.bounding_radius(),
                                std::max(A.scale_at(t0), A.scale_at(t1)), in.growth.rate);
   }
@@ -374,7 +401,8 @@ struct Solver {
   Sample eval(double t) {
     Sample s;
     s.t = t;
-    const Pose pa = A.pose_at(t), pb = B.pose_at(t);
+    Vec3 wa, wb;
+    const Pose pa = A.pose_at(t, wa), pb = B.pose_at(t, wb);
     s.res = solve_distance(t, pa, pb);
     ++out.distance_evals;
     out.distance_nr_iterations += s.res.nr_iterations;
@@ -386,8 +414,8 @@ struct Solver {
     }
     warm = s.res.warm;
     s.d = s.res.distance;
-    const Vec3 ua = A.point_velocity(s.res.point_a, pa, t);
-    const Vec3 ub = B.point_velocity(s.res.point_b, pb, t);
+    const Vec3 ua = A.point_velocity(s.res.point_a, pa, t, wa);
+    const Vec3 ub = B.point_velocity(s.res.point_b, pb, t, wb);
     s.dd = s.res.normal.dot(ub - ua);
     out.min_distance = std::min(out.min_distance, s.d);
     return s;
@@ -396,7 +424,8 @@ struct Solver {
   static constexpr bool kAxis = SupportShape<SA> && SupportShape<SB>;
   // Second-order axis steps (both curvature radii finite, AxisGap::curved).
   bool curved_axes() const {
-    if constexpr (kAxis) return AxisGap<SA, SB>::curved(in.shape_a, in.shape_b);
+    if constexpr (kAxis)
+      return AxisGap<SA, SB>::curved(in.shape_a, in.shape_b);
     else return false;
   }
 
@@ -410,7 +439,7 @@ struct Solver {
   // contact/axis_gap.hpp).
   double advance_on_axis(const Vec3& n, double t0, double hi) {
     using Gap = AxisGap<SA, SB>;
-    Gap G(in.shape_a, in.a, in.shape_b, in.b, in.t_state, n, grow ? in.growth.s : 1.0,
+    Gap G(in.shape_a, A.motion, in.shape_b, B.motion, in.t_state, n, grow ? in.growth.s : 1.0,
           grow ? in.growth.rate : 0.0);
     // Second-order steps converge on the gap's zero: follow it closer than eps_d. They also
     // leave a touching pair that separates (g ~ 0, g' > 0: just after its collision): the
@@ -551,7 +580,7 @@ struct Solver {
         // a gap of K (hi - lo) already rules out any contact in the window
         const double reach = hi < kInf ? (grow ? rate_bound(lo, hi) : K) * (hi - lo) : kInf;
         double g0;
-        const Vec3 n = separating_axis(in.shape_a, in.a, in.shape_b, in.b, lo - in.t_state, 3, g0,
+        const Vec3 n = separating_axis(in.shape_a, A.motion, in.shape_b, B.motion, lo - in.t_state, 3, g0,
                                        reach, grow ? A.scale_at(lo) : 1.0);
         if (!(n.squaredNorm() > 0.0)) break;
         if (g0 >= reach) return;  // none

@@ -11,7 +11,9 @@
 // Per face f (outward unit normal n, plane n.x = c, faces as in geometry/obb.hpp) the signed
 // distance of the body is closed form (DESIGN.md, geometry/plane.hpp):
 //     d_f(t) = c - margin - n.r(t) - h(R(t)^T n),
-// with r(t) = r + v (t - t_state) and R(t) = exp(skew(w) (t - t_state)) R (free_flight.hpp).
+// with r(t) = r + v (t - t_state) and R(t) = exp(skew(w) (t - t_state)) R (free_flight.hpp;
+// for a top that is not spherical R(t) and w(t) of motion/motion.hpp, and |w x n| below bounded
+// by max |w(t)|).
 // Its rate: d/dt R^T n = -R^T (w x n), and grad h = p (the support point), so
 //     d_f'(t) = -n.v + (R p).(w x n),   |d_f'| <= K_f = |n.v| + |w x n| L,
 // L the bounding radius (|R p| <= L). This is the paper's Eq. distplover, tightened by using
@@ -44,6 +46,7 @@
 #include "math/brent.hpp"
 #include "math/types.hpp"
 #include "motion/free_flight.hpp"
+#include "motion/motion.hpp"
 #include "shapes/shape.hpp"
 
 namespace hb {
@@ -87,17 +90,21 @@ struct BoxDistance {
   Mat3 axes;
   Vec3 lim;              // half - margin
   double L;
+  Motion motion;         // the rotation (any top; motion/motion.hpp)
 
   BoxDistance(const S& s, const BodyState& b, double ts, const Obb& box, double margin)
       : shape(s), st(b), t_state(ts), axes(box.axes), lim(box.half.array() - margin),
-        L(s.bounding_radius()) {
+        L(s.bounding_radius()), motion(b) {
     st.r = b.r - box.centre;
   }
   // d_f at t for every face; with rates when dd is non-null.
   void at(double t, std::array<double, 6>& d, std::array<double, 6>* dd = nullptr) const {
     const double tau = t - t_state;
     const Vec3 r = st.r + st.v * tau;
-    const Mat3 R = rotation_at(st, tau);
+    Quat q;
+    Vec3 w;
+    motion.pose(tau, q, w);
+    const Mat3 R = q.toRotationMatrix();
     const Vec3 x = axes.transpose() * r;        // centre along the box axes
     const Mat3 Rn = R.transpose() * axes;       // column k: box axis k in the body frame
     for (int k = 0; k < 3; ++k) {
@@ -106,7 +113,7 @@ struct BoxDistance {
       d[2 * k + 1] = lim[k] - x[k] - shape.support(nb);
       if (dd) {
         const Vec3 u = axes.col(k);
-        const Vec3 wxu = st.w.cross(u);
+        const Vec3 wxu = w.cross(u);
         const double vn = st.v.dot(u);
         const Vec3 pm = R * shape.support_point(-nb), pp = R * shape.support_point(nb);
         (*dd)[2 * k] = vn - pm.dot(wxu);
@@ -119,20 +126,24 @@ struct BoxDistance {
     const int k = f >> 1;
     const Vec3 u = (f & 1) ? Vec3(axes.col(k)) : Vec3(-axes.col(k));
     const Vec3 r = st.r + st.v * tau;
-    const Mat3 R = rotation_at(st, tau);
+    const Mat3 R = motion.rotation(tau);
     return lim[k] - u.dot(r) - shape.support(R.transpose() * u);
   }
   double face_rate(int f, double t) const {
     const double tau = t - t_state;
     const int k = f >> 1;
     const Vec3 u = (f & 1) ? Vec3(axes.col(k)) : Vec3(-axes.col(k));
-    const Mat3 R = rotation_at(st, tau);
-    return -u.dot(st.v) + (R * shape.support_point(R.transpose() * u)).dot(st.w.cross(u));
+    Quat q;
+    Vec3 w;
+    motion.pose(tau, q, w);
+    const Mat3 R = q.toRotationMatrix();
+    return -u.dot(st.v) + (R * shape.support_point(R.transpose() * u)).dot(w.cross(u));
   }
-  // |d_f'| <= K_f
+  // |d_f'| <= K_f (a top that is not spherical: |w x u| <= max |w(t)|)
   double rate_bound(int f) const {
     const Vec3 u = axes.col(f >> 1);
-    return std::abs(st.v.dot(u)) + st.w.cross(u).norm() * L;
+    const double wu = motion.spherical() ? st.w.cross(u).norm() : motion.max_angular_speed();
+    return std::abs(st.v.dot(u)) + wu * L;
   }
 };
 

@@ -153,6 +153,7 @@ void add_checkpoint_logs(gsd::HoomdFrame& f, const State& s, const LoopSnapshot&
   f.log["hardbody/obs_nematic"] = row(d.nematic);
   f.log["hardbody/pair_collisions"] = row(d.pair_collisions);
   f.log["hardbody/obs_gr_partial"] = row(d.gr_partial);
+  f.log["hardbody/obs_temperatures"] = row(d.temperatures);
   for (std::size_t a = 0; a < d.corr_species.size(); ++a)
     f.log[fmt::format("hardbody/obs_correlations_species{}", a)] = row(d.corr_species[a]);
   f.log["hardbody/config"] = row(config_signature(c).values);
@@ -267,6 +268,7 @@ void read_core(const Reader& r, Box& box, State& s, LoopSnapshot& loop, DriverSt
   d.nematic = record("hardbody/obs_nematic");
   d.pair_collisions = record("hardbody/pair_collisions");
   d.gr_partial = record("hardbody/obs_gr_partial");
+  d.temperatures = record("hardbody/obs_temperatures");
   d.corr_species.clear();
   for (std::size_t a = 0; r.f.log.count(fmt::format("hardbody/obs_correlations_species{}", a)); ++a)
     d.corr_species.push_back(record(fmt::format("hardbody/obs_correlations_species{}", a).c_str()));

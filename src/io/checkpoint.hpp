@@ -32,6 +32,7 @@ struct DriverState {
   double next_corr = 0.0, next_gr = 0.0;   // next sampling times of the observables
   std::vector<double> corr, gr, nematic;   // their save() records
   std::vector<double> gr_partial;          // PartialRadialDistribution::save() (mixtures)
+  std::vector<double> temperatures;        // SpeciesTemperatures::save()
   std::vector<std::vector<double>> corr_species;  // TimeCorrelations::save() per species (mixtures)
   std::vector<double> pair_collisions;     // measured collisions per species pair a <= b (row-major upper triangle)
 };

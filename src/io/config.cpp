@@ -620,9 +620,10 @@ std::string config_reference() {
          "| `mass` | number | 1 | body mass at scale 1 |\n"
          "| `inertia` | number or 3 numbers | uniform solid | principal moments along body x, y, z (positive, I_a + I_b >= I_c); one number: a spherical top |\n"
          "| `polydispersity` | table | none | `{ distribution = \"gaussian\" or \"uniform\", width = w }`: body sizes scaled by s with mean 1 and relative standard deviation w in (0, 0.3) (gaussian truncated at 3 w); mass scales as s^3, inertia as s^5 |\n"
-         "\nMixtures start from a random placement at `init.phi0` grown to `system.packing_fraction` (at most 0.6)\n"
-         "and use cell lists. So far every species of a mixture must be a sphere, and non-spherical bodies\n"
-         "must be spherical tops.\n";
+         "\nMixtures (and polydisperse bodies) start from a random placement at `init.phi0` (lower if the\n"
+         "bodies' bounding spheres would fill more than a quarter of the box) grown to\n"
+         "`system.packing_fraction` (at most 0.6), and use cell lists. Any shapes may be mixed; a body\n"
+         "whose principal moments differ rotates as the exact free symmetric or asymmetric top.\n";
   return out;
 }
 

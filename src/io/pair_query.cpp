@@ -70,6 +70,11 @@ Body parse_body(const json& j, const char* name, bool moving, const Where& w) {
     const Eigen::VectorXd om = numbers(b, "angular_velocity", 3, w);
     out.st.v = Vec3(v[0], v[1], v[2]);
     out.st.w = Vec3(om[0], om[1], om[2]);
+    if (b.contains("inertia")) {  // optional: principal moments; the body rotates as that top
+      const Eigen::VectorXd I = numbers(b, "inertia", 3, w);
+      if (!(I.minCoeff() > 0.0)) w.fail(fmt::format("{}: key 'inertia' must be 3 positive numbers", name));
+      out.st.top = spherical_top(Vec3(I[0], I[1], I[2])) ? Vec3::Zero() : Vec3(I[0], I[1], I[2]);
+    }
   }
   return out;
 }

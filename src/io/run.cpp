@@ -148,7 +148,7 @@ class Driver {
       : cfg_(cfg), opt_(opt), dir_(dir), sim_(sim), st_(st), ops_(ops),
         extra_(std::move(extra)),
         corr_(correlation_spec(cfg)), rdf_(rdf_spec(cfg)),
-        gr_partial_(cfg.species.size(), int(cfg.gr_bins)) {
+        gr_partial_(cfg.species.size(), int(cfg.gr_bins)), temps_(cfg.species.size()) {
     if (partial_gr()) corr_species_.assign(cfg.species.size(), TimeCorrelations(correlation_spec(cfg)));
     for (std::size_t a = 0; a < std::min(corr_species_.size(), st_.corr_species.size()); ++a)
       if (!st_.corr_species[a].empty()) corr_species_[a].load(st_.corr_species[a]);
@@ -157,6 +157,7 @@ class Driver {
     if (!st_.gr.empty()) rdf_.load(st_.gr);
     if (!st_.nematic.empty()) nem_.load(st_.nematic);
     if (!st_.gr_partial.empty()) gr_partial_.load(st_.gr_partial);
+    if (!st_.temperatures.empty()) temps_.load(st_.temperatures);
     const std::size_t ns = cfg_.species.size();
     st_.pair_collisions.resize(ns * (ns + 1) / 2, 0.0);
   }
@@ -247,6 +248,7 @@ class Driver {
         pressure_.close_block(sim_.now() - st_.block_start, kT, n);
         st_.block_start = sim_.now();
         nem_.sample(sim_.now(), synchronized_state(sim_), sim_.box());
+        temps_.sample(species_temperatures(synchronized_state(sim_)));
         log.row(sim_.now() - t_eq, double(sim_.collisions()) - st_.coll0, pressure_.last_Z(),
                 pressure_.Z().mean, kT, (energy() - st_.e0) / st_.e0,
                 pressure_.collision_rate().mean);
@@ -278,6 +280,7 @@ class Driver {
     st_.corr = corr_.save();
     st_.gr = rdf_.save();
     st_.nematic = nem_.save();
+    st_.temperatures = temps_.save();
     if (partial_gr()) st_.gr_partial = gr_partial_.save();
     st_.corr_species.clear();
     for (const auto& c : corr_species_) st_.corr_species.push_back(c.save());
@@ -328,20 +331,32 @@ class Driver {
     const State& s = sim_.state();
     st_.pair_collisions[pair_index(s.species[r.a], s.species[r.b])] += 1.0;
   }
-  // summary.json "species": per species its resolved mass and inertia and its temperatures;
-  // "species_pairs": measured collision rate of a body of species a with bodies of species b.
-  void species_summary(nlohmann::json& j, const State& st, double measured_time) const {
+  // One sample of SpeciesTemperatures from a synchronized state: per species the translational
+  // temperature and I_k W_k^2 per principal axis (W the body-frame angular velocity).
+  std::vector<double> species_temperatures(const State& st) const {
     const std::size_t ns = cfg_.species.size();
-    std::vector<double> kt(ns, 0.0), n(ns, 0.0);
-    std::vector<Vec3> kr(ns, Vec3::Zero());
+    std::vector<double> out(ns * SpeciesTemperatures::kValues, 0.0), n(ns, 0.0);
     for (std::size_t i = 0; i < st.size(); ++i) {
       const std::size_t a = st.species[i];
       const double sc = st.scale[i];
       n[a] += 1.0;
-      kt[a] += ops_.body_mass(st, i) * st.v[i].squaredNorm();
+      out[4 * a] += ops_.body_mass(st, i) * st.v[i].squaredNorm() / 3.0;
       const Vec3 wb = st.q[i].conjugate() * st.w[i];  // body-frame angular velocity
-      kr[a] += (cfg_.species[a].inertia * std::pow(sc, 5)).cwiseProduct(wb.cwiseProduct(wb));
+      const Vec3 kr = (cfg_.species[a].inertia * std::pow(sc, 5)).cwiseProduct(wb.cwiseProduct(wb));
+      for (int k = 0; k < 3; ++k) out[4 * a + 1 + k] += kr[k];
     }
+    for (std::size_t a = 0; a < ns; ++a)
+      for (std::size_t c = 0; c < 4; ++c) out[4 * a + c] /= std::max(n[a], 1.0);
+    return out;
+  }
+  // summary.json "species": per species its resolved mass and inertia and its temperatures (means
+  // over the log blocks of the measured run with block-averaged errors; the final state if no
+  // block closed); "species_pairs": measured collision rate of a body of species a with bodies of
+  // species b.
+  void species_summary(nlohmann::json& j, const State& st, double measured_time) const {
+    const std::size_t ns = cfg_.species.size();
+    SpeciesTemperatures temps = temps_;
+    if (temps.samples() == 0) temps.sample(species_temperatures(st));
     nlohmann::json list = nlohmann::json::array();
     for (std::size_t a = 0; a < ns; ++a) {
       const Species& sp = cfg_.species[a];
@@ -350,13 +365,18 @@ class Driver {
       o["count"] = sp.count;
       o["mass"] = sp.mass;
       o["inertia"] = {sp.inertia.x(), sp.inertia.y(), sp.inertia.z()};
-      o["temperature_translational"] = kt[a] / (3.0 * n[a]);
+      const MeanError tt = temps.get(a, 0);
+      o["temperature_translational"] = tt.mean;
+      o["temperature_translational_error"] = tt.error;
       if (std::holds_alternative<Sphere>(sp.shape)) {  // smooth spheres never exchange spin
         o["temperature_rotational"] = nullptr;
         o["temperature_rotational_axes"] = nullptr;
+        o["temperature_rotational_axes_error"] = nullptr;
       } else {
-        o["temperature_rotational"] = kr[a].sum() / (3.0 * n[a]);
-        o["temperature_rotational_axes"] = {kr[a].x() / n[a], kr[a].y() / n[a], kr[a].z() / n[a]};
+        const MeanError rx = temps.get(a, 1), ry = temps.get(a, 2), rz = temps.get(a, 3);
+        o["temperature_rotational"] = (rx.mean + ry.mean + rz.mean) / 3.0;
+        o["temperature_rotational_axes"] = {rx.mean, ry.mean, rz.mean};
+        o["temperature_rotational_axes_error"] = {rx.error, ry.error, rz.error};
       }
       if (sp.poly.active()) o["polydispersity"] = {{"width", sp.poly.width}};
       list.push_back(o);
@@ -368,7 +388,7 @@ class Driver {
         // each a-b collision involves one body of a and one of b (two of a when a == b)
         const double c = st_.pair_collisions[pair_index(a, b)] * (a == b ? 2.0 : 1.0);
         pairs.push_back({{"a", cfg_.species[a].name}, {"b", cfg_.species[b].name}, {"collisions", st_.pair_collisions[pair_index(a, b)]},
-                         {"collision_rate", measured_time > 0.0 ? c / (n[a] * measured_time) : 0.0}});
+                         {"collision_rate", measured_time > 0.0 ? c / (double(cfg_.species[a].count) * measured_time) : 0.0}});
       }
     j["species_pairs"] = pairs;
   }
@@ -491,6 +511,7 @@ class Driver {
   PartialRadialDistribution gr_partial_;  // mixtures: g_ab(r)
   std::vector<TimeCorrelations> corr_species_;  // mixtures: MSD, C2, F_self per species
   NematicOrder nem_;
+  SpeciesTemperatures temps_;  // per species and axis, one sample per log block
   Progress progress_;
   double cpu_mark_ = 0.0, wall_mark_ = 0.0, last_checkpoint_ = 0.0;
   std::uint64_t snapshot_overlaps_ = 0;

@@ -84,4 +84,41 @@ class VirialPressure {
   std::vector<double> z_, rate_;
 };
 
+// Temperatures per species, sampled at the end of every log block: translational 2 K_t / (3 n)
+// and, per principal body axis k, I_k W_k^2 / n (W the body-frame angular velocity; equipartition
+// makes each equal to kT). Reported as block-averaged means with standard errors. The caller
+// computes the four sums of a sample (sample()); the observer only keeps the series.
+class SpeciesTemperatures {
+ public:
+  static constexpr std::size_t kValues = 4;  // translational, rotational x, y, z
+  explicit SpeciesTemperatures(std::size_t species = 0) : series_(species * kValues) {}
+
+  // values[a * 4 + c]: species a, component c (see the class comment).
+  void sample(const std::vector<double>& values) {
+    if (values.size() != series_.size()) throw std::invalid_argument("SpeciesTemperatures: wrong sample size");
+    for (std::size_t k = 0; k < values.size(); ++k) series_[k].push_back(values[k]);
+  }
+  std::size_t samples() const { return series_.empty() ? 0 : series_[0].size(); }
+  MeanError get(std::size_t species, std::size_t component) const {
+    return block_average(series_[species * kValues + component]);
+  }
+
+  std::vector<double> save() const {
+    std::vector<double> d{double(series_.size()), double(samples())};
+    for (const auto& x : series_) d.insert(d.end(), x.begin(), x.end());
+    return d;
+  }
+  void load(const std::vector<double>& d) {
+    if (d.size() < 2 || d.size() != 2 + std::size_t(d[0]) * std::size_t(d[1]) ||
+        std::size_t(d[0]) != series_.size())
+      throw std::invalid_argument("temperature accumulator record has the wrong length");
+    const std::size_t n = std::size_t(d[1]);
+    for (std::size_t k = 0; k < series_.size(); ++k)
+      series_[k].assign(d.begin() + 2 + k * n, d.begin() + 2 + (k + 1) * n);
+  }
+
+ private:
+  std::vector<std::vector<double>> series_;
+};
+
 }  // namespace hb

@@ -46,23 +46,33 @@ HardSphereMixture plan_sphere_mixture(const Config& c) {
   return m;
 }
 
+RigidMixture plan_rigid_mixture(const Config& c) {
+  if (c.neighbors_method != "cells")
+    throw ConfigError(fmt::format("{}: key 'neighbors.method': mixtures and polydisperse bodies "
+                                  "use cell lists (\"cells\") so far", c.source));
+  RigidMixture m = RigidMixture::of(c.species, c.eps_d);
+  double v = 0.0;
+  for (const Species& sp : c.species) v += double(sp.count) * volume(sp.shape);
+  const double L = std::cbrt(v / c.packing_fraction);
+  if (L < 2.0 * m.interaction_range())
+    throw ConfigError(fmt::format(
+        "{}: key 'species': {} bodies at packing fraction {} give a box of side {:.3g}, less than "
+        "two interaction ranges ({:.3g}); use more bodies", c.source, c.particles, c.packing_fraction,
+        L, 2.0 * m.interaction_range()));
+  return m;
+}
+
 RigidSystemSpec plan_rigid(const Config& c) {
   if (c.mixture())
-    throw ConfigError(fmt::format("{}: key 'species': mixtures and polydispersity of non-spherical "
-                                  "bodies are not supported yet (spheres only)", c.source));
+    throw std::logic_error("plan_rigid: one species without polydispersity only");
   const Species& sp = c.one();
-  if (!sp.spherical_top())
-    throw ConfigError(fmt::format(
-        "{}: key '{}inertia': the principal moments ({:.6g}, {:.6g}, {:.6g}) make a symmetric or "
-        "asymmetric top; only spherical tops (inertia = one number) are supported yet",
-        c.source, c.species_given ? "species[0]." : "shape.", sp.inertia.x(), sp.inertia.y(), sp.inertia.z()));
   RigidSystemSpec p;
   p.n = c.particles;
   p.phi = c.packing_fraction;
   p.semi_axes = half_extents(sp.shape);
   if (const auto* q = std::get_if<Superquadric>(&sp.shape)) p.exponents = q->exponents();
   p.mass = sp.mass;
-  p.inertia = sp.inertia.x();
+  p.inertia = sp.inertia;
   p.kT = c.temperature;
   p.seed = c.seed;
   p.eps_d = c.eps_d;

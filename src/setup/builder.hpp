@@ -14,8 +14,9 @@
 //                            the simulation a checkpoint describes, continued bit for bit
 //   ops()                    kinetic energy, temperature and the independent overlap check
 // One-species hard spheres take the analytic fast path (HardSpheres), sphere mixtures and
-// polydisperse spheres HardSphereMixture (cell lists, a grown random start); every other shape
-// the generic rigid-body model of its registry type (one species, spherical tops, so far).
+// polydisperse spheres HardSphereMixture (cell lists, a grown random start); one species of
+// another shape the rigid-body model of its registry type (any top; cells or oriented-box lists);
+// every other mixture the generic RigidMixture (cell lists, a grown random start).
 #pragma once
 #include <fmt/format.h>
 
@@ -96,6 +97,7 @@ struct StartOptions {
 SphereSystemSpec plan_spheres(const Config& c);        // one species of spheres
 HardSphereMixture plan_sphere_mixture(const Config& c);  // several species or polydisperse spheres
 RigidSystemSpec plan_rigid(const Config& c);           // one species of non-spherical bodies
+RigidMixture plan_rigid_mixture(const Config& c);      // any other mixture or polydispersity
 
 template <class Model, class Neighbors>
 class Assembly {
@@ -186,8 +188,8 @@ inline UnitBody unit_body_of(const Superquadric& q) {
 
 template <Shape S, class F>
 void assemble_rigid(const Config& c, const S& shape, F&& f) {
-  const RigidSystemSpec spec = plan_rigid(c);  // one species, a spherical top
-  const RigidBodies<S> model{shape, MassProperties::spherical_top(spec.mass, spec.inertia), spec.eps_d};
+  const RigidSystemSpec spec = plan_rigid(c);  // one species (any top)
+  const RigidBodies<S> model{shape, MassProperties::principal(spec.mass, spec.inertia), spec.eps_d};
   SystemOps ops{species_masses(c.species), [model](const State& s) { return model.kinetic_energy(s); },
                 independent_overlap_check(c.one().shape)};
   const UnitBody unit = unit_body_of(shape);
@@ -218,6 +220,36 @@ void assemble_rigid(const Config& c, const S& shape, F&& f) {
     f(Assembly<RigidBodies<S>, CellNeighbors>(model, CellNeighbors(model.interaction_range()), ops, start));
 }
 
+// Mixtures with non-spherical species, and polydisperse non-spherical bodies: the generic
+// RigidMixture over cell lists, started by random placement and growth of every body.
+template <class F>
+void assemble_rigid_mixture(const Config& c, F&& f) {
+  const RigidMixture model = plan_rigid_mixture(c);
+  SystemOps ops{species_masses(c.species), [model](const State& s) { return model.kinetic_energy(s); },
+                mixture_overlap_check(model.shape)};
+  GrowthOptions go;
+  go.rate = c.init_growth_rate;
+  go.phi0 = std::min(c.init_phi0, c.packing_fraction);
+  go.kT = c.temperature;
+  auto start = [species = c.species, phi = c.packing_fraction, seed = c.seed, eps_d = c.eps_d, go,
+                check = ops.overlaps](const StartOptions& opt) {
+    if (!opt.quiet)
+      std::fprintf(stderr, "hardbody: placing at phi <= %g, growing to %g (rate %g) ...\n", go.phi0, phi, go.rate);
+    Start s;
+    s.info.method = "grow";
+    s.info.growth = go;
+    s.info.result = grow_rigid_mixture(species, phi, seed, go, eps_d);
+    s.info.result.overlaps = check(s.info.result.state, s.info.result.box);
+    if (s.info.result.overlaps.overlaps != 0)
+      throw std::runtime_error(fmt::format("mixture growth: {} overlapping pairs (seed {})",
+                                           s.info.result.overlaps.overlaps, seed));
+    s.box = s.info.result.box;
+    s.state = std::move(s.info.result.state);
+    return s;
+  };
+  f(Assembly<RigidMixture, CellNeighbors>(model, CellNeighbors(model.interaction_range()), ops, start));
+}
+
 }  // namespace builder_detail
 
 // Calls f(assembly) with the typed Assembly of the config (see the header).
@@ -226,9 +258,7 @@ void assemble(const Config& c, F&& f) {
   bool spheres = true;
   for (const Species& sp : c.species) spheres = spheres && std::holds_alternative<Sphere>(sp.shape);
   if (spheres) return builder_detail::assemble_spheres(c, f);
-  if (c.mixture())  // (before the visit: a mixture led by a sphere would match no rigid branch)
-    throw ConfigError(fmt::format("{}: key 'species': mixtures and polydispersity of non-spherical "
-                                  "bodies are not supported yet (spheres only)", c.source));
+  if (c.mixture()) return builder_detail::assemble_rigid_mixture(c, f);
   std::visit(
       [&](const auto& shape) {
         if constexpr (!std::is_same_v<std::decay_t<decltype(shape)>, Sphere>)

@@ -60,6 +60,7 @@ struct GrowingRigidBodies {
     return 2.0 * shape.bounding_radius() * std::max(law.s0, law.final_scale());
   }
   ScaleLaw scale_law(double now) const { return ScaleLaw{law.scale_at(now), law.rate_at(now)}; }
+  void prepare(State& s) const { s.tops.assign(1, mass.top()); }
 
   void contact_times(const State& s, const Box& box, std::uint32_t i, const std::uint32_t* js,
                      const Vec3* shifts, std::size_t n, double now, const double* horizons,
@@ -112,19 +113,20 @@ struct GrowingRigidBodies {
     const double grow = growth_speed(sc, sdot, d.normal, r_ab);
     const double L = shp.bounding_radius();
     const double rate = (b.v - a.v).norm() + (a.w.norm() + b.w.norm()) * L + 2.0 * sdot / sc * L;
-    return collide_separating(s, i, j, a, b, mass, d, r_ab, grow, rate, stats);
+    return collide_separating(s, i, j, a, b, mass, mass, d, r_ab, grow, rate, stats);
   }
 
   double kinetic_energy(const State& s) const { return total_kinetic_energy(s, mass); }
 };
 
-// Translational and rotational kinetic energies of spherical tops.
+// Rescale translational and rotational velocities to the temperature kT (any tops: the
+// rotational kinetic energy w.I_lab w / 2 is quadratic in w).
 inline void rescale_to_temperature(State& s, const MassProperties& mass, double kT) {
-  if (!mass.spherical) throw std::invalid_argument("rescale_to_temperature: spherical tops only");
   double kt = 0.0, kr = 0.0;
   for (std::size_t i = 0; i < s.size(); ++i) {
     kt += 0.5 * mass.mass * s.v[i].squaredNorm();
-    kr += 0.5 * s.w[i].squaredNorm() / mass.inv_scalar_inertia;
+    kr += mass.spherical ? 0.5 * s.w[i].squaredNorm() / mass.inv_scalar_inertia
+                         : 0.5 * s.w[i].dot(mass.apply_inertia(s.q[i], s.w[i]));
   }
   const double target = 1.5 * double(s.size()) * kT;
   const double ft = kt > 0.0 ? std::sqrt(target / kt) : 1.0;
@@ -237,7 +239,7 @@ GrowthResult grow_lattice(const S& shape, const RigidSystemSpec& spec, const Gro
   const double s0 = std::cbrt(opt.phi0 / spec.phi);
   box.L *= s0;
   for (auto& r : st.r) r *= s0;
-  GrowthResult res = grow_bodies(shape, MassProperties::spherical_top(spec.mass, spec.inertia),
+  GrowthResult res = grow_bodies(shape, MassProperties::principal(spec.mass, spec.inertia),
                                  std::move(st), box, s0, opt, spec.eps_d);
   res.overlaps = check(res.state, res.box);
   if (res.overlaps.overlaps != 0)

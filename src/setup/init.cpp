@@ -70,6 +70,23 @@ void maxwell_boltzmann_spin(State& s, double kT, double inertia, std::uint64_t s
   }
 }
 
+void maxwell_boltzmann_spin(State& s, double kT, const Vec3& inertia, std::uint64_t seed) {
+  if (spherical_top(inertia)) return maxwell_boltzmann_spin(s, kT, inertia[0], seed);
+  pcg64 rng(seed, 0x7370696e73706e31ull);  // the same stream as the spherical top's
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  const Vec3 sd = (kT / inertia.array()).sqrt().matrix();
+  double k = 0.0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const Vec3 W(sd[0] * gauss(rng), sd[1] * gauss(rng), sd[2] * gauss(rng));  // body frame
+    s.w[i] = s.q[i] * W;
+    k += 0.5 * W.dot(inertia.cwiseProduct(W));
+  }
+  if (k > 0.0) {
+    const double scale = std::sqrt(1.5 * s.size() * kT / k);
+    for (auto& w : s.w) w *= scale;
+  }
+}
+
 double kinetic_energy(const State& s, double mass) {
   double k = 0.0;
   for (const auto& v : s.v) k += v.squaredNorm();

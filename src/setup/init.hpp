@@ -24,6 +24,10 @@ void maxwell_boltzmann(State& s, double kT, double mass, std::uint64_t seed);
 // Random angular velocities for bodies with scalar moment of inertia I (spherical tops),
 // rescaled so that the rotational temperature 2 K_rot / (3 N) equals kT.
 void maxwell_boltzmann_spin(State& s, double kT, double inertia, std::uint64_t seed);
+// Principal moments `inertia` along the body axes (s.q must be set): each body-frame component
+// of the angular velocity drawn from N(0, kT / I_k), then turned to the lab; the total
+// rotational kinetic energy rescaled to 3 N kT / 2. Equal moments: the spherical-top draw above.
+void maxwell_boltzmann_spin(State& s, double kT, const Vec3& inertia, std::uint64_t seed);
 
 double kinetic_energy(const State& s, double mass);
 Vec3 total_momentum(const State& s, double mass);

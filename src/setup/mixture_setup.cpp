@@ -139,4 +139,85 @@ GrowthResult grow_sphere_mixture(const SpeciesTable& species, double phi, std::u
   return res;
 }
 
+void maxwell_boltzmann_spin(State& s, double kT, const std::vector<Vec3>& inertia, std::uint64_t seed) {
+  pcg64 rng(seed, 0x7370696e73706e31ull);  // the stream of the one-species spins
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  double k = 0.0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const Vec3& I = inertia[i];
+    const Vec3 W(std::sqrt(kT / I[0]) * gauss(rng), std::sqrt(kT / I[1]) * gauss(rng),
+                 std::sqrt(kT / I[2]) * gauss(rng));  // body frame
+    s.w[i] = s.q[i] * W;
+    k += 0.5 * W.dot(I.cwiseProduct(W));
+  }
+  if (k > 0.0) {
+    const double f = std::sqrt(1.5 * double(s.size()) * kT / k);
+    for (auto& w : s.w) w *= f;
+  }
+}
+
+void random_orientations(State& s, std::uint64_t seed) {
+  pcg64 rng(seed, 0x6f7269656e747331ull);  // stream "orients1"
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  for (auto& q : s.q) {  // a normalised 4-d Gaussian is uniform on the rotations
+    Quat x;
+    do x = Quat(gauss(rng), gauss(rng), gauss(rng), gauss(rng)); while (!(x.norm() > 1e-3));
+    q = x.normalized();
+  }
+}
+
+double rescale_to_temperature(State& s, const RigidMixture& model, double kT) {
+  double kt = 0.0, kr = 0.0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const MassProperties m = model.body_mass(s, i);
+    kt += 0.5 * m.mass * s.v[i].squaredNorm();
+    kr += 0.5 * s.w[i].dot(m.apply_inertia(s.q[i], s.w[i]));
+  }
+  const double target = 1.5 * double(s.size()) * kT;
+  const double ft = kt > 0.0 ? std::sqrt(target / kt) : 1.0;
+  const double fr = kr > 0.0 ? std::sqrt(target / kr) : 1.0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    s.v[i] *= ft;
+    s.w[i] *= fr;
+  }
+  const double after = (kt > 0.0 ? target : 0.0) + (kr > 0.0 ? target : 0.0);
+  return kt + kr - after;
+}
+
+GrowthResult grow_rigid_mixture(const SpeciesTable& species, double phi, std::uint64_t seed,
+                                const GrowthOptions& opt, double eps_d) {
+  if (!(opt.phi0 > 0.0) || opt.phi0 > phi) throw std::invalid_argument("grow_rigid_mixture: need 0 < phi0 <= phi");
+  State st = species_state(species, seed);
+  Box box;
+  box.L = Vec3::Constant(std::cbrt(body_volume(species, st) / phi));
+  double v_bounding = 0.0;  // bounding-sphere volume at scale 1
+  for (std::size_t i = 0; i < st.size(); ++i)
+    v_bounding += 4.18879020478639 * std::pow(bounding_radius(species[st.species[i]].shape) * st.scale[i], 3);
+  const double s0 = std::min(std::cbrt(opt.phi0 / phi), std::cbrt(0.25 * box.volume() / v_bounding));
+  const double t_stop = (1.0 - s0) / opt.rate;
+  RigidMixture model = RigidMixture::of(species, eps_d, GrowthLaw{s0, opt.rate, 0.0, t_stop});
+  std::vector<double> radii(st.size()), masses(st.size());
+  std::vector<Vec3> inertia(st.size());
+  for (std::size_t i = 0; i < st.size(); ++i) {
+    radii[i] = bounding_radius(species[st.species[i]].shape) * st.scale[i] * s0;
+    const MassProperties m = model.body_mass(st, i);
+    masses[i] = m.mass;
+    inertia[i] = m.inertia_body.diagonal();
+  }
+  st.r = random_sphere_placement(radii, box, seed);
+  random_orientations(st, seed);
+  maxwell_boltzmann(st, opt.kT, masses, seed);
+  maxwell_boltzmann_spin(st, opt.kT, inertia, seed);
+  GrowthResult res;
+  if (s0 < 1.0) {
+    res = run_growth(model, std::move(st), box, opt,
+                     [&](State& x) { return rescale_to_temperature(x, model, opt.kT); });
+  } else {
+    res.state = std::move(st), res.box = box, res.s0 = 1.0;
+  }
+  res.s0 = s0;
+  res.phi = body_volume(species, res.state) / box.volume();
+  return res;
+}
+
 }  // namespace hb

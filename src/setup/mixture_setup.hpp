@@ -1,6 +1,6 @@
-// Starts of mixtures and polydisperse systems (sphere species so far): each body's species and
-// size scale, random placement of the bodies at a dilute packing fraction, Maxwell–Boltzmann
-// velocities with per-body masses, and Lubachevsky–Stillinger growth to the target
+// Starts of mixtures and polydisperse systems (any shapes): each body's species and size scale,
+// random placement of the bodies at a dilute packing fraction, Maxwell–Boltzmann velocities with
+// per-body masses and spins per principal axis, and Lubachevsky–Stillinger growth to the target
 // (docs/initial_states.md).
 #pragma once
 #include <cstdint>
@@ -10,6 +10,7 @@
 #include "setup/growth.hpp"
 #include "system/box.hpp"
 #include "system/hard_sphere_mixture.hpp"
+#include "system/rigid_mixture.hpp"
 #include "system/state.hpp"
 
 namespace hb {
@@ -30,6 +31,26 @@ std::vector<Vec3> random_sphere_placement(const std::vector<double>& radii, cons
 // Gaussian velocities with per-body masses, zero total momentum, rescaled so that
 // 2 K / (3 N) = kT exactly (deterministic for the seed).
 void maxwell_boltzmann(State& s, double kT, const std::vector<double>& masses, std::uint64_t seed);
+
+// Angular velocities with per-body principal moments `inertia` (body axes; s.q must be set): each
+// body-frame component from N(0, kT / I_k), turned to the lab, the rotational kinetic energy
+// rescaled to 3 N kT / 2 (deterministic for the seed).
+void maxwell_boltzmann_spin(State& s, double kT, const std::vector<Vec3>& inertia, std::uint64_t seed);
+
+// Uniformly random orientations (deterministic for the seed).
+void random_orientations(State& s, std::uint64_t seed);
+
+// Rescale the translational and the rotational kinetic energy of `model`'s bodies each to
+// 3 N kT / 2; returns the kinetic energy removed (the growth thermostat).
+double rescale_to_temperature(State& s, const RigidMixture& model, double kT);
+
+// The dense start of a mixture of any shapes at packing fraction phi (of the target sizes):
+// random placement of the bodies' bounding spheres, shrunk by s0, in the target box (s0 the
+// smaller of (phi0 / phi)^(1/3) and the scale at which the bounding spheres fill a quarter of the
+// box: random addition of spheres jams near 0.38), random orientations, then growth to s = 1 with
+// the RigidMixture model and the thermostat at opt.kT. The state is synchronized, time stamps 0.
+GrowthResult grow_rigid_mixture(const SpeciesTable& species, double phi, std::uint64_t seed,
+                                const GrowthOptions& opt, double eps_d);
 
 // The dense start of a sphere mixture at packing fraction phi (of the target sizes): random
 // placement of bodies shrunk by s0 = (phi0 / phi)^(1/3) in the target box, then growth to s = 1

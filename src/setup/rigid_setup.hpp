@@ -33,7 +33,7 @@ struct RigidSystemSpec {
   double phi = 0.3;
   Vec3 semi_axes = Vec3(1.0, 0.5, 0.5);
   double mass = 1.0;
-  double inertia = 0.1;  // scalar moment of inertia (spherical top)
+  Vec3 inertia = Vec3::Constant(0.1);  // principal moments along the body axes (equal: spherical top)
   double kT = 1.0;
   std::uint64_t seed = 1;
   double eps_d = 1e-5;
@@ -140,13 +140,13 @@ inline State superquadric_start(const RigidSystemSpec& s, Box& box) {
 
 inline RigidBodies<Ellipsoid> ellipsoid_model(const RigidSystemSpec& s) {
   RigidBodies<Ellipsoid> m{Ellipsoid{s.semi_axes.x(), s.semi_axes.y(), s.semi_axes.z()},
-                           MassProperties::spherical_top(s.mass, s.inertia), s.eps_d};
+                           MassProperties::principal(s.mass, s.inertia), s.eps_d};
   return m;
 }
 
 inline RigidBodies<Superquadric> superquadric_model(const RigidSystemSpec& s) {
   return RigidBodies<Superquadric>{superquadric_shape(s),
-                                   MassProperties::spherical_top(s.mass, s.inertia), s.eps_d};
+                                   MassProperties::principal(s.mass, s.inertia), s.eps_d};
 }
 
 inline EllipsoidCellSim make_ellipsoid_cell_simulation(const RigidSystemSpec& s) {

@@ -52,6 +52,26 @@ class SolverFailure : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// One line of `hardbody contact-time` input for bodies a and b (shape JSON given) moving from
+// their states over [0, t_max]: the reproducer of a failed solve. A body that is not a spherical
+// top carries its principal moments ("inertia").
+inline std::string contact_reproducer(const std::string& shape_a, const BodyState& a,
+                                      const std::string& shape_b, const BodyState& b, double t_max) {
+  auto body = [](const std::string& shape, const BodyState& x) {
+    std::string top;
+    if (!spherical_top(x.top))
+      top = fmt::format(", \"inertia\": [{:.17g}, {:.17g}, {:.17g}]", x.top.x(), x.top.y(), x.top.z());
+    return fmt::format(
+        "{{\"shape\": {}, \"position\": [{:.17g}, {:.17g}, {:.17g}], \"orientation\": [{:.17g}, "
+        "{:.17g}, {:.17g}, {:.17g}], \"velocity\": [{:.17g}, {:.17g}, {:.17g}], "
+        "\"angular_velocity\": [{:.17g}, {:.17g}, {:.17g}]{}}}",
+        shape, x.r.x(), x.r.y(), x.r.z(), x.q.w(), x.q.x(), x.q.y(), x.q.z(), x.v.x(), x.v.y(),
+        x.v.z(), x.w.x(), x.w.y(), x.w.z(), top);
+  };
+  return fmt::format("{{\"a\": {}, \"b\": {}, \"t_max\": {:.17g}}}", body(shape_a, a),
+                     body(shape_b, b), t_max);
+}
+
 inline double total_kinetic_energy(const State& s, const MassProperties& mass) {
   double k = 0.0;
   for (std::size_t i = 0; i < s.size(); ++i) k += hb::kinetic_energy(s.body(i), mass);
@@ -69,9 +89,10 @@ inline double total_kinetic_energy(const State& s, const MassProperties& mass) {
 // (through the growth term of the impulse rule: the gap opens at max(closing, eps_v)); the
 // energy change is of order eps_v^2, ~1e-16 relative.
 inline CollisionRecord collide_separating(State& s, std::uint32_t i, std::uint32_t j, BodyState a,
-                                          BodyState b, const MassProperties& mass,
-                                          const DistanceResult& d, const Vec3& r_ab, double grow,
-                                          double rate, SolverStats& stats) {
+                                          BodyState b, const MassProperties& mass_a,
+                                          const MassProperties& mass_b, const DistanceResult& d,
+                                          const Vec3& r_ab, double grow, double rate,
+                                          SolverStats& stats) {
   const Vec3 x_c = 0.5 * (d.point_a + d.point_b);
   const double closing = contact_relative_velocity(a, b, x_c, r_ab).dot(d.normal) + grow;
   const double eps_v = 1e-8 * rate;
@@ -80,7 +101,7 @@ inline CollisionRecord collide_separating(State& s, std::uint32_t i, std::uint32
     g_eff = grow + 0.5 * (eps_v - closing);
     ++stats.grazing_separations;
   }
-  CollisionRecord rec = hb::collide(a, mass, b, mass, x_c, d.normal, r_ab, g_eff);
+  CollisionRecord rec = hb::collide(a, mass_a, b, mass_b, x_c, d.normal, r_ab, g_eff);
   s.v[i] = a.v, s.w[i] = a.w;
   s.v[j] = b.v, s.w[j] = b.w;
   rec.a = i;
@@ -102,6 +123,8 @@ struct RigidBodies {
   bool trim_horizons = true;
 
   double interaction_range() const { return 2.0 * shape.bounding_radius(); }
+  // Bodies rotate as the top their inertia makes (motion/motion.hpp).
+  void prepare(State& s) const { s.tops.assign(1, mass.top()); }
 
   void contact_times(const State& s, const Box& box, std::uint32_t i, const std::uint32_t* js,
                      const Vec3* shifts, std::size_t n, double now, const double* horizons,
@@ -139,21 +162,13 @@ struct RigidBodies {
       throw SolverFailure(fmt::format("distance solver failed at the collision of {} and {}", i, j));
     if (d.status == DistanceStatus::fallback) ++stats.collision_distance_fallbacks;
     const double rate = (b.v - a.v).norm() + (a.w.norm() + b.w.norm()) * shape.bounding_radius();
-    return collide_separating(s, i, j, a, b, mass, d, r_ab, 0.0, rate, stats);
+    return collide_separating(s, i, j, a, b, mass, mass, d, r_ab, 0.0, rate, stats);
   }
 
   double kinetic_energy(const State& s) const { return total_kinetic_energy(s, mass); }
 
   std::string reproducer(const BodyState& a, const BodyState& b, double t_max) const {
-    auto body = [&](const BodyState& x) {
-      return fmt::format(
-          "{{\"shape\": {}, \"position\": [{:.17g}, {:.17g}, {:.17g}], \"orientation\": [{:.17g}, "
-          "{:.17g}, {:.17g}, {:.17g}], \"velocity\": [{:.17g}, {:.17g}, {:.17g}], "
-          "\"angular_velocity\": [{:.17g}, {:.17g}, {:.17g}]}}",
-          hb::shape_json(shape), x.r.x(), x.r.y(), x.r.z(), x.q.w(), x.q.x(), x.q.y(), x.q.z(), x.v.x(),
-          x.v.y(), x.v.z(), x.w.x(), x.w.y(), x.w.z());
-    };
-    return fmt::format("{{\"a\": {}, \"b\": {}, \"t_max\": {:.17g}}}", body(a), body(b), t_max);
+    return contact_reproducer(hb::shape_json(shape), a, hb::shape_json(shape), b, t_max);
   }
 };
 

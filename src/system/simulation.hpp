@@ -53,6 +53,13 @@ struct StepInfo {
   CollisionRecord record;            // filled for real collisions
 };
 
+// The pair model tells the State what it needs to stream its bodies (the kind of top of each
+// species, State::tops) when it has a prepare(State&).
+template <class Model>
+void prepare_state(const Model& m, State& s) {
+  if constexpr (requires { m.prepare(s); }) m.prepare(s);
+}
+
 template <class Model, class Neighbors, class Queue = IndexedHeap>
 class Simulation {
  public:
@@ -62,6 +69,7 @@ class Simulation {
   Simulation(const Box& box, State state, Model model, Neighbors neighbors, double now = 0.0)
       : box_(box), state_(std::move(state)), model_(std::move(model)),
         nb_(std::move(neighbors)), now_(now) {
+    prepare_state(model_, state_);
     const std::size_t n = state_.size();
     if (n == 0) throw std::invalid_argument("no particles");
     nb_.init(box_, state_, now_);
@@ -75,6 +83,7 @@ class Simulation {
   Simulation(const Box& box, State state, Model model, Neighbors neighbors, const LoopSnapshot& snap)
       : box_(box), state_(std::move(state)), model_(std::move(model)), nb_(std::move(neighbors)),
         now_(snap.now), best_(snap.best), counts_(snap.counts), stale_(snap.stale) {
+    prepare_state(model_, state_);
     const std::size_t n = state_.size();
     if (snap.slot.size() != n || snap.best.size() != n)
       throw std::invalid_argument("snapshot does not match the number of bodies");

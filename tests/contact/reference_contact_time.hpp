@@ -11,6 +11,8 @@
 // so d is unimodal there).  A negative value brackets the first contact, which is then
 // bisected on the sign of the reference distance to 1e-14 relative in time.  The distance rate
 // comes from the support points: d' = n.(u_B(x_B) - u_A(x_A)).
+// Any tops (BodyState::top): the pose and angular velocity at t come from the exact free rotation
+// (motion/motion.hpp; tested on its own against Euler's equations), |w| in K by its maximum.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -19,6 +21,7 @@
 #include "geometry/reference_distance.hpp"
 #include "math/types.hpp"
 #include "motion/free_flight.hpp"
+#include "motion/motion.hpp"
 
 namespace hb::ref {
 
@@ -34,21 +37,26 @@ struct RefPair {
   const SA& a;
   const SB& b;
   BodyState sa, sb;  // at time 0
+  Motion ma{sa}, mb{sb};
   Vec3 hint = Vec3::Zero();
   long evals = 0;
 
   // distance and its rate at time t
   std::pair<double, double> at(double t) {
-    const Pose pa{sa.r + sa.v * t, rotation_at(sa, t)};
-    const Pose pb{sb.r + sb.v * t, rotation_at(sb, t)};
+    Quat qa, qb;
+    Vec3 wa, wb;
+    ma.pose(t, qa, wa);
+    mb.pose(t, qb, wb);
+    const Pose pa{sa.r + sa.v * t, qa.toRotationMatrix()};
+    const Pose pb{sb.r + sb.v * t, qb.toRotationMatrix()};
     // with a hint from the previous (nearby) time, 8 extra starts suffice for the small
     // overlaps met here (bisection and golden search around a first contact)
     const bool h = hint.squaredNorm() > 0;
     const RefDistance r = reference_distance(a, pa, b, pb, h ? &hint : nullptr, h ? 8 : 48);
     ++evals;
     hint = r.n;
-    const Vec3 ua = sa.v + sa.w.cross(r.point_a - pa.r);
-    const Vec3 ub = sb.v + sb.w.cross(r.point_b - pb.r);
+    const Vec3 ua = sa.v + wa.cross(r.point_a - pa.r);
+    const Vec3 ub = sb.v + wb.cross(r.point_b - pb.r);
     return {r.distance, r.n.dot(ub - ua)};
   }
 };
@@ -58,8 +66,8 @@ template <SupportShape SA, SupportShape SB>
 RefContact reference_contact_time(const SA& a, const BodyState& sa, const SB& b,
                                   const BodyState& sb, double t_max, double d_fine) {
   RefPair<SA, SB> P{a, b, sa, sb};
-  const double K = (sb.v - sa.v).norm() + sa.w.norm() * a.bounding_radius() +
-                   sb.w.norm() * b.bounding_radius();
+  const double K = (sb.v - sa.v).norm() + P.ma.max_angular_speed() * a.bounding_radius() +
+                   P.mb.max_angular_speed() * b.bounding_radius();
   RefContact out;
   auto finish_root = [&](double lo, double hi) {  // d(lo) > 0 > d(hi)
     while (hi - lo > 1e-14 * std::max(1.0, hi)) {

@@ -25,8 +25,9 @@ struct Pair {
 };
 
 // Separated ellipsoids (aspect up to 5), moving and spinning, B at distance `gap` along a
-// random direction at t = 0.
-Pair random_pair(Rng& r, double gap) {
+// random direction at t = 0; `tops`: asymmetric tops with random principal moments (their w
+// changes along the flight), otherwise spherical tops.
+Pair random_pair(Rng& r, double gap, bool tops = false) {
   Pair p;
   p.a = r.ellipsoid(5.0);
   p.b = r.ellipsoid(5.0);
@@ -35,6 +36,10 @@ Pair random_pair(Rng& r, double gap) {
   const Pose pb = testing::place_at_distance(p.a, pa, p.b, r.rotation(), r.unit(), gap);
   p.sa = BodyState{pa.r, Quat(pa.R), r.ball(1.0), r.ball(3.0 / L)};
   p.sb = BodyState{pb.r, Quat(pb.R), r.ball(1.0), r.ball(3.0 / L)};
+  if (tops) {
+    p.sa.top = Vec3(r.uni(0.2, 1.0), r.uni(0.2, 1.0), r.uni(0.2, 1.0));
+    p.sb.top = Vec3(r.uni(0.2, 1.0), r.uni(0.2, 1.0), r.uni(0.2, 1.0));
+  }
   return p;
 }
 
@@ -46,14 +51,16 @@ double reference_distance_at(const Pair& p, double t) {
 
 // Rate of the gap against central differences, |g'| <= Kn and |FD g''| <= M on random axes;
 // `growing`: random scale laws s0 + sdot tau, bounds for the largest scale on |tau| <= 1.
-void check_rate_and_curvature(std::uint64_t seed, bool growing) {
+void check_rate_and_curvature(std::uint64_t seed, bool growing, bool tops = false) {
   Rng r(seed);
-  double worst_rate = 0.0, worst_curv = 0.0, worst_k = 0.0;
+  double worst_rate = 0.0, worst_curv = 0.0, worst_k = 0.0, worst_fd = 0.0;
   const int n = scaled_count(2000, 0.1);
   for (int k = 0; k < n; ++k) {
-    const Pair p = random_pair(r, r.log_uni(1e-3, 2.0));
+    const Pair p = random_pair(r, r.log_uni(1e-3, 2.0), tops);
     const double s0 = growing ? r.uni(0.5, 1.5) : 1.0, sdot = growing ? r.uni(-0.2, 0.5) : 0.0;
-    AxisGap<Ellipsoid, Ellipsoid> g(p.a, p.sa, p.b, p.sb, 0.0, r.unit(), s0, sdot);
+    const Motion mota(p.sa), motb(p.sb);
+    AxisGap<Ellipsoid, Ellipsoid> g(p.a, mota, p.b, motb, 0.0, r.unit(), s0, sdot);
+    EXPECT_TRUE(g.is_curved());
     g.bounds(s0 + std::abs(sdot));
     const double t = r.uni(-0.9, 0.9), h = 1e-5;
     double slope;
@@ -63,10 +70,13 @@ void check_rate_and_curvature(std::uint64_t seed, bool growing) {
     worst_rate = std::max(worst_rate, std::abs((gp - gm) / (2 * h) - slope) / g.Kn);
     worst_curv = std::max(worst_curv, std::abs((gp - 2 * g0 + gm) / (h * h)) / g.M);
     worst_k = std::max(worst_k, std::abs(slope) / g.Kn);
+    worst_fd = std::max(worst_fd, std::abs((gp - gm) / (2 * h)) / g.Kn);
   }
-  std::printf("  %d %s axes: max |g' - FD| / Kn %.2e, max |g'| / Kn %.3f, max |FD g''| / M %.3f\n",
-              n, growing ? "growing" : "rigid", worst_rate, worst_k, worst_curv);
+  std::printf("  %d %s%s axes: max |g' - FD| / Kn %.2e, max |g'| / Kn %.3f, max |FD g''| / M %.3f\n",
+              n, growing ? "growing" : "rigid", tops ? " asymmetric-top" : "", worst_rate, worst_k,
+              worst_curv);
   EXPECT_LT(worst_rate, 1e-6);
+  EXPECT_LE(worst_fd, 1.0 + 1e-6);         // the rate bound holds
   EXPECT_LE(worst_k, 1.0 + 1e-12);
   EXPECT_LE(worst_curv, 1.0 + 1e-3);  // FD of g'' is accurate to ~1e-5 relative here
 }
@@ -77,31 +87,42 @@ TEST(AxisGap, GrowingShapesRateAndCurvatureMatchFiniteDifferencesAndBounds) {
   check_rate_and_curvature(59, true);
 }
 
-TEST(AxisGap, IsALowerBoundOfTheDistanceAndExactAlongTheNormal) {
-  Rng r(43);
+// Asymmetric tops: g' against central differences, |g'| <= Kn with the max-|w| bound and
+// |g''| <= M with the max-|W'| bound, rigid and growing.
+TEST(AxisGap, AsymmetricTopsRateBound) {
+  check_rate_and_curvature(61, false, true);
+  check_rate_and_curvature(67, true, true);
+}
+
+void check_lower_bound(std::uint64_t seed, bool tops) {
+  Rng r(seed);
   const int n = scaled_count(1000, 0.1);
   double worst_excess = -kInf, worst_normal = 0.0;
   for (int k = 0; k < n; ++k) {
-    const Pair p = random_pair(r, r.log_uni(1e-4, 2.0));
+    const Pair p = random_pair(r, r.log_uni(1e-4, 2.0), tops);
+    const Motion ma(p.sa), mb(p.sb);
     const double t = r.uni(0.0, 0.3);
     const double d = reference_distance_at(p, t);
     if (!(d > 0.0)) continue;  // moved into contact: no statement
     // random axes: never above the distance
     for (int m = 0; m < 5; ++m) {
-      const AxisGap<Ellipsoid, Ellipsoid> g(p.a, p.sa, p.b, p.sb, 0.0, r.unit());
+      const AxisGap<Ellipsoid, Ellipsoid> g(p.a, ma, p.b, mb, 0.0, r.unit());
       worst_excess = std::max(worst_excess, g.value(t) - d);
     }
     // the normal at the closest points of t = 0: equal to the distance there
     const Pose pa{p.sa.r, p.sa.q.toRotationMatrix()}, pb{p.sb.r, p.sb.q.toRotationMatrix()};
     const auto rd = ref::reference_distance(p.a, pa, p.b, pb);
-    const AxisGap<Ellipsoid, Ellipsoid> g(p.a, p.sa, p.b, p.sb, 0.0, rd.n);
+    const AxisGap<Ellipsoid, Ellipsoid> g(p.a, ma, p.b, mb, 0.0, rd.n);
     worst_normal = std::max(worst_normal, std::abs(g.value(0.0) - rd.distance));
   }
-  std::printf("  %d pairs: max (g - d) on random axes %.2e, max |g - d| along the normal %.2e\n", n,
-              worst_excess, worst_normal);
+  std::printf("  %d pairs%s: max (g - d) on random axes %.2e, max |g - d| along the normal %.2e\n",
+              n, tops ? " (asymmetric tops)" : "", worst_excess, worst_normal);
   EXPECT_LE(worst_excess, 1e-12);
   EXPECT_LE(worst_normal, 1e-9);
 }
+
+TEST(AxisGap, IsALowerBoundOfTheDistanceAndExactAlongTheNormal) { check_lower_bound(43, false); }
+TEST(AxisGap, AsymmetricTopsLowerBound) { check_lower_bound(71, true); }
 
 TEST(AxisGap, SeparatingAxisSearchApproachesTheDistance) {
   Rng r(47);
@@ -112,8 +133,9 @@ TEST(AxisGap, SeparatingAxisSearchApproachesTheDistance) {
     const Pair p = random_pair(r, r.log_uni(1e-3, 1.0));
     const double d = reference_distance_at(p, 0.0);
     double g3, g200;
-    separating_axis(p.a, p.sa, p.b, p.sb, 0.0, 3, g3);
-    separating_axis(p.a, p.sa, p.b, p.sb, 0.0, 400, g200);
+    const Motion ma(p.sa), mb(p.sb);
+    separating_axis(p.a, ma, p.b, mb, 0.0, 3, g3);
+    separating_axis(p.a, ma, p.b, mb, 0.0, 400, g200);
     worst_excess = std::max({worst_excess, g3 - d, g200 - d});
     worst_long = std::max(worst_long, (d - g200) / d);
     ratio3.push_back(g3 / d);
@@ -137,7 +159,8 @@ TEST(AxisGap, SuperquadricsUseTheFirstOrderBound) {
   for (int k = 0; k < n; ++k) {
     const BodyState a{Vec3::Zero(), r.quat(), r.ball(1.0), r.ball(3.0)};
     const BodyState b{Vec3(2.5, 0, 0) + r.ball(0.3), r.quat(), r.ball(1.0), r.ball(3.0)};
-    const AxisGap<Superquadric, Superquadric> g(q, a, q, b, 0.0, r.unit());
+    const Motion ma(a), mb(b);
+    const AxisGap<Superquadric, Superquadric> g(q, ma, q, mb, 0.0, r.unit());
     EXPECT_FALSE(g.is_curved());
     const double t = r.uni(-0.2, 0.2), h = 1e-6;
     worst = std::max(worst, std::abs(g.value(t + h) - g.value(t - h)) / (2 * h) / g.Kn);
@@ -157,8 +180,9 @@ TEST(AxisGap, SuperquadricWithExponentsTwoIsCurvedLikeTheEllipsoid) {
     const Superquadric qa{p.a.a, p.a.b, p.a.c, 2, 2, 2}, qb{p.b.a, p.b.b, p.b.c, 2, 2, 2};
     ASSERT_NEAR(qa.max_curvature_radius(), p.a.max_curvature_radius(), 1e-15);
     const Vec3 axis = r.unit();
-    const AxisGap<Superquadric, Superquadric> g(qa, p.sa, qb, p.sb, 0.0, axis);
-    const AxisGap<Ellipsoid, Ellipsoid> ge(p.a, p.sa, p.b, p.sb, 0.0, axis);
+    const Motion ma0(p.sa), mb0(p.sb);
+    const AxisGap<Superquadric, Superquadric> g(qa, ma0, qb, mb0, 0.0, axis);
+    const AxisGap<Ellipsoid, Ellipsoid> ge(p.a, ma0, p.b, mb0, 0.0, axis);
     ASSERT_TRUE(g.is_curved());
     const double t = r.uni(-0.9, 0.9), h = 1e-5;
     double slope, slope_e;

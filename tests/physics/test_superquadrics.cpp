@@ -89,7 +89,7 @@ TEST(SuperquadricExponentTwo, SameCollisionsAsEllipsoid) {
   spec.phi = 0.3;
   spec.semi_axes = Vec3(1.0, 0.5, 0.5);
   spec.exponents = Vec3(2.0, 2.0, 2.0);
-  spec.inertia = 0.1;
+  spec.inertia = Vec3::Constant(0.1);
   spec.seed = 8;
   Box box;
   const State st = ellipsoid_start(spec, box);

@@ -1,0 +1,165 @@
+// Pair model of hard rigid bodies of several species: any shapes of the registry, sizes
+// (polydispersity), masses and principal moments of inertia (spherical, symmetric and asymmetric
+// tops), optionally growing (Lubachevsky–Stillinger starts). The generic path of
+// system/rigid_bodies.hpp: one species of identical bodies keeps RigidBodies<S>, and both give
+// the same trajectory for one species (tests/system/test_rigid_mixture.cpp).
+//
+// Body i of species k is the species shape resized by scale_i (shapes/registry.hpp `resized`), of
+// mass m_k scale_i^3 and principal moments I_k scale_i^5 (uniform density scaled about the
+// centre). Every pair goes through the one generic contact-time solver, dispatched on the two
+// shape types (every pair of engine shapes is compiled: contact/contact_time_*.cpp); impulses use
+// the inertia tensors (collision/rigid.hpp), free flight the exact free rotation of each body's
+// top (motion/motion.hpp; State::tops, set by prepare()).
+//
+// Growth. With law.growing(), every body is scaled by the common s(t) on top of its own scale
+// (contact/contact_time.hpp ScaleLaw: a decorator of the two motions); the collision rule gets
+// the outward surface speeds grow = (s'/s) n.r_AB (setup/growth.hpp derives it), and predictions
+// stop at law.t_stop, where the law changes. Without growth (the default law) every prediction is
+// the rigid one.
+#pragma once
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <variant>
+#include <vector>
+
+#include "collision/rigid.hpp"
+#include "contact/contact_time.hpp"
+#include "core/species.hpp"
+#include "geometry/distance.hpp"
+#include "motion/growth_law.hpp"
+#include "shapes/codec.hpp"
+#include "shapes/registry.hpp"
+#include "system/box.hpp"
+#include "system/rigid_bodies.hpp"
+#include "system/state.hpp"
+
+namespace hb {
+
+struct RigidMixture {
+  static constexpr bool kWindowed = true;  // predictions only up to the body's next neighbour event
+
+  std::vector<AnyShape> shape;         // per species, at scale 1
+  std::vector<double> mass;            // per species, at scale 1
+  std::vector<Vec3> inertia;           // per species: principal moments at scale 1
+  std::vector<double> max_scale;       // per species: bound of the body scales drawn
+  double eps_d = 1e-5;
+  ContactOptions options{};
+  GrowthLaw law{};                     // default: no growth
+  mutable SolverStats stats{};
+  bool trim_horizons = true;           // as RigidBodies::trim_horizons
+
+  static RigidMixture of(const SpeciesTable& species, double eps_d, GrowthLaw law = {}) {
+    RigidMixture m;
+    for (const Species& sp : species) {
+      m.shape.push_back(sp.shape);
+      m.mass.push_back(sp.mass);
+      m.inertia.push_back(sp.inertia);
+      m.max_scale.push_back(sp.poly.max_scale());
+    }
+    m.eps_d = eps_d;
+    m.law = law;
+    return m;
+  }
+
+  // Largest centre distance at contact over the run (the final size when growing).
+  double interaction_range() const {
+    double r = 0.0;
+    for (std::size_t k = 0; k < shape.size(); ++k)
+      r = std::max(r, bounding_radius(shape[k]) * max_scale[k]);
+    const double smax = law.growing() ? std::max(law.s0, law.final_scale()) : law.s0;
+    return 2.0 * r * smax;
+  }
+  void prepare(State& s) const {
+    s.tops.resize(inertia.size());
+    for (std::size_t k = 0; k < inertia.size(); ++k)
+      s.tops[k] = spherical_top(inertia[k]) ? Vec3::Zero() : inertia[k];
+  }
+
+  AnyShape body_shape(const State& s, std::size_t i) const {
+    const double sc = s.scale[i];
+    return sc == 1.0 ? shape[s.species[i]] : resized(shape[s.species[i]], sc);
+  }
+  MassProperties body_mass(const State& s, std::size_t i) const {
+    const double sc = s.scale[i], s3 = sc * sc * sc;
+    return MassProperties::principal(mass[s.species[i]] * s3, inertia[s.species[i]] * (s3 * sc * sc));
+  }
+
+  void contact_times(const State& s, const Box& box, std::uint32_t i, const std::uint32_t* js,
+                     const Vec3* shifts, std::size_t n, double now, const double* horizons,
+                     double* out) const {
+    const BodyState a = s.body(i);  // body i is at `now`
+    const AnyShape sa = body_shape(s, i);
+    const ScaleLaw sl{law.scale_at(now), law.rate_at(now)};
+    const double law_end = now < law.t_stop ? law.t_stop : kInf;  // the law changes there
+    double earliest = kInf;
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::uint32_t j = js[k];
+      out[k] = kInf;
+      const double horizon =
+          trim_horizons ? std::min({horizons ? horizons[k] : kInf, law_end, earliest}) : law_end;
+      if (j == i || !(horizon > now)) continue;
+      BodyState b = s.body_at(j, now);
+      b.r = shifts ? Vec3(b.r + shifts[k]) : Vec3(a.r + box.near_image(b.r - a.r));
+      const AnyShape sb = body_shape(s, j);
+      const ContactResult r = std::visit(
+          [&](const auto& A, const auto& B) {
+            using SA = std::decay_t<decltype(A)>;
+            using SB = std::decay_t<decltype(B)>;
+            ContactInput<SA, SB> in{A, B, a, b, now, now, horizon, eps_d};
+            in.growth = sl;
+            return contact_time(in, options);
+          },
+          sa, sb);
+      stats.add(r);
+      if (r.status == ContactStatus::failed)
+        throw SolverFailure(fmt::format(
+            "contact-time solver failed for bodies {} and {} at t = {:.17g} (growth scale "
+            "{:.17g}, rate {:.17g}); reproducer: {}",
+            i, j, now, sl.s, sl.rate, reproducer(sa, a, sb, b, horizon - now)));
+      if (r.status == ContactStatus::hit) {
+        out[k] = std::max(0.0, r.time - now);
+        earliest = std::min(earliest, r.time);
+      }
+    }
+  }
+
+  CollisionRecord collide(State& s, const Box& box, std::uint32_t i, std::uint32_t j,
+                          double now) const {
+    BodyState a = s.body(i), b = s.body(j);  // both at `now`
+    const double sc = law.scale_at(now), sdot = law.rate_at(now);
+    const AnyShape sa = body_shape(s, i), sb = body_shape(s, j);
+    const Vec3 r_ab = box.near_image(b.r - a.r);
+    const Pose pa{a.r, a.q.toRotationMatrix()};
+    const Pose pb{Vec3(a.r + r_ab), b.q.toRotationMatrix()};
+    const DistanceResult d = std::visit(
+        [&](const auto& A, const auto& B) {
+          if (sc == 1.0) return distance(A, pa, B, pb, options.distance);
+          return distance(resized(A, sc), pa, resized(B, sc), pb, options.distance);
+        },
+        sa, sb);
+    if (d.status == DistanceStatus::failed)
+      throw SolverFailure(fmt::format("distance solver failed at the collision of {} and {}", i, j));
+    if (d.status == DistanceStatus::fallback) ++stats.collision_distance_fallbacks;
+    const double grow = std::max(0.0, (sdot / sc) * d.normal.dot(r_ab));
+    const double La = bounding_radius(sa) * sc, Lb = bounding_radius(sb) * sc;
+    const double rate = (b.v - a.v).norm() + a.w.norm() * La + b.w.norm() * Lb +
+                        (sdot / sc) * (La + Lb);
+    return collide_separating(s, i, j, a, b, body_mass(s, i), body_mass(s, j), d, r_ab, grow,
+                              rate, stats);
+  }
+
+  double kinetic_energy(const State& s) const {
+    double k = 0.0;
+    for (std::size_t i = 0; i < s.size(); ++i) k += hb::kinetic_energy(s.body(i), body_mass(s, i));
+    return k;
+  }
+
+  static std::string reproducer(const AnyShape& sa, const BodyState& a, const AnyShape& sb,
+                                const BodyState& b, double t_max) {
+    return contact_reproducer(shape_json(sa), a, shape_json(sb), b, t_max);
+  }
+};
+
+}  // namespace hb
