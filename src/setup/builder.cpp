@@ -29,20 +29,26 @@ SphereSystemSpec plan_spheres(const Config& c) {
   return p;
 }
 
+namespace {
+// The box of a mixture (of the mean body volume) must hold two interaction ranges.
+void check_mixture_box(const Config& c, double range) {
+  double v = 0.0;
+  for (const Species& sp : c.species) v += double(sp.count) * volume(sp.shape);
+  const double L = std::cbrt(v / c.packing_fraction);
+  if (L < 2.0 * range)
+    throw ConfigError(fmt::format(
+        "{}: key 'species': {} bodies at packing fraction {} give a box of side {:.3g}, less than "
+        "two interaction ranges ({:.3g}); use more bodies", c.source, c.particles, c.packing_fraction,
+        L, 2.0 * range));
+}
+}  // namespace
+
 HardSphereMixture plan_sphere_mixture(const Config& c) {
   if (c.neighbors_method != "cells")
     throw ConfigError(fmt::format("{}: key 'neighbors.method': sphere mixtures and polydisperse spheres "
                                   "use cell lists (\"cells\"); shell lists need one diameter", c.source));
   HardSphereMixture m = HardSphereMixture::of(c.species);
-  // the box (of the mean volume) must hold two interaction ranges
-  double v = 0.0;
-  for (const Species& sp : c.species) v += double(sp.count) * volume(sp.shape);
-  const double L = std::cbrt(v / c.packing_fraction);
-  if (L < 2.0 * m.interaction_range())
-    throw ConfigError(fmt::format(
-        "{}: key 'species': {} bodies at packing fraction {} give a box of side {:.3g}, less than "
-        "two interaction ranges ({:.3g}); use more bodies", c.source, c.particles, c.packing_fraction,
-        L, 2.0 * m.interaction_range()));
+  check_mixture_box(c, m.interaction_range());
   return m;
 }
 
@@ -51,14 +57,7 @@ RigidMixture plan_rigid_mixture(const Config& c) {
     throw ConfigError(fmt::format("{}: key 'neighbors.method': mixtures and polydisperse bodies "
                                   "use cell lists (\"cells\") so far", c.source));
   RigidMixture m = RigidMixture::of(c.species, c.eps_d);
-  double v = 0.0;
-  for (const Species& sp : c.species) v += double(sp.count) * volume(sp.shape);
-  const double L = std::cbrt(v / c.packing_fraction);
-  if (L < 2.0 * m.interaction_range())
-    throw ConfigError(fmt::format(
-        "{}: key 'species': {} bodies at packing fraction {} give a box of side {:.3g}, less than "
-        "two interaction ranges ({:.3g}); use more bodies", c.source, c.particles, c.packing_fraction,
-        L, 2.0 * m.interaction_range()));
+  check_mixture_box(c, m.interaction_range());
   return m;
 }
 
