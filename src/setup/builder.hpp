@@ -131,6 +131,23 @@ class Assembly {
 
 namespace builder_detail {
 
+// The start of a mixture grown with options go: its state, checked by the independent test (an
+// overlap throws).
+inline Start grown_start(GrowthResult result, const GrowthOptions& go, const OverlapCheck& check,
+                         std::uint64_t seed) {
+  Start s;
+  s.info.method = "grow";
+  s.info.growth = go;
+  s.info.result = std::move(result);
+  s.info.result.overlaps = check(s.info.result.state, s.info.result.box);
+  if (s.info.result.overlaps.overlaps != 0)
+    throw std::runtime_error(fmt::format("mixture growth: {} overlapping pairs (seed {})",
+                                         s.info.result.overlaps.overlaps, seed));
+  s.box = s.info.result.box;
+  s.state = std::move(s.info.result.state);
+  return s;
+}
+
 template <class F>
 void assemble_spheres(const Config& c, F&& f) {
   if (c.mixture()) {
@@ -149,17 +166,7 @@ void assemble_spheres(const Config& c, F&& f) {
                   check = ops.overlaps](const StartOptions& opt) {
       if (!opt.quiet)
         std::fprintf(stderr, "hardbody: placing at phi = %g, growing to %g (rate %g) ...\n", go.phi0, phi, go.rate);
-      Start s;
-      s.info.method = "grow";
-      s.info.growth = go;
-      s.info.result = grow_sphere_mixture(species, phi, seed, go);
-      s.info.result.overlaps = check(s.info.result.state, s.info.result.box);
-      if (s.info.result.overlaps.overlaps != 0)
-        throw std::runtime_error(fmt::format("sphere mixture growth: {} overlapping pairs (seed {})",
-                                             s.info.result.overlaps.overlaps, seed));
-      s.box = s.info.result.box;
-      s.state = std::move(s.info.result.state);
-      return s;
+      return grown_start(grow_sphere_mixture(species, phi, seed, go), go, check, seed);
     };
     f(Assembly<HardSphereMixture, CellNeighbors>(model, CellNeighbors(model.interaction_range()), ops, start));
     return;
@@ -235,17 +242,7 @@ void assemble_rigid_mixture(const Config& c, F&& f) {
                 check = ops.overlaps](const StartOptions& opt) {
     if (!opt.quiet)
       std::fprintf(stderr, "hardbody: placing at phi <= %g, growing to %g (rate %g) ...\n", go.phi0, phi, go.rate);
-    Start s;
-    s.info.method = "grow";
-    s.info.growth = go;
-    s.info.result = grow_rigid_mixture(species, phi, seed, go, eps_d);
-    s.info.result.overlaps = check(s.info.result.state, s.info.result.box);
-    if (s.info.result.overlaps.overlaps != 0)
-      throw std::runtime_error(fmt::format("mixture growth: {} overlapping pairs (seed {})",
-                                           s.info.result.overlaps.overlaps, seed));
-    s.box = s.info.result.box;
-    s.state = std::move(s.info.result.state);
-    return s;
+    return grown_start(grow_rigid_mixture(species, phi, seed, go, eps_d), go, check, seed);
   };
   f(Assembly<RigidMixture, CellNeighbors>(model, CellNeighbors(model.interaction_range()), ops, start));
 }

@@ -103,13 +103,9 @@ struct GrowingRigidBodies {
     BodyState a = s.body(i), b = s.body(j);  // both at `now`
     const double sc = law.scale_at(now), sdot = law.rate_at(now);
     const auto shp = scaled_shape(shape, sc);
-    const Vec3 r_ab = box.near_image(b.r - a.r);
-    const Pose pa{a.r, a.q.toRotationMatrix()};
-    const Pose pb{Vec3(a.r + r_ab), b.q.toRotationMatrix()};
-    const DistanceResult d = distance(shp, pa, shp, pb, options.distance);
-    if (d.status == DistanceStatus::failed)
-      throw SolverFailure(fmt::format("distance solver failed at the collision of {} and {}", i, j));
-    if (d.status == DistanceStatus::fallback) ++stats.collision_distance_fallbacks;
+    const auto [r_ab, d] = collision_contact(a, b, box, i, j, stats, [&](const Pose& pa, const Pose& pb) {
+      return distance(shp, pa, shp, pb, options.distance);
+    });
     const double grow = growth_speed(sc, sdot, d.normal, r_ab);
     const double L = shp.bounding_radius();
     const double rate = (b.v - a.v).norm() + (a.w.norm() + b.w.norm()) * L + 2.0 * sdot / sc * L;
@@ -118,6 +114,19 @@ struct GrowingRigidBodies {
 
   double kinetic_energy(const State& s) const { return total_kinetic_energy(s, mass); }
 };
+
+// Scale every v and every w so that the translational kinetic energy kt and the rotational one
+// kr both become 3 N kT / 2 (a zero one stays zero); returns the kinetic energy removed.
+inline double scale_to_temperature(State& s, double kt, double kr, double kT) {
+  const double target = 1.5 * double(s.size()) * kT;
+  const double ft = kt > 0.0 ? std::sqrt(target / kt) : 1.0;
+  const double fr = kr > 0.0 ? std::sqrt(target / kr) : 1.0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    s.v[i] *= ft;
+    s.w[i] *= fr;
+  }
+  return kt + kr - ((kt > 0.0 ? target : 0.0) + (kr > 0.0 ? target : 0.0));
+}
 
 // Rescale translational and rotational velocities to the temperature kT (any tops: the
 // rotational kinetic energy w.I_lab w / 2 is quadratic in w).
@@ -128,13 +137,7 @@ inline void rescale_to_temperature(State& s, const MassProperties& mass, double 
     kr += mass.spherical ? 0.5 * s.w[i].squaredNorm() / mass.inv_scalar_inertia
                          : 0.5 * s.w[i].dot(mass.apply_inertia(s.q[i], s.w[i]));
   }
-  const double target = 1.5 * double(s.size()) * kT;
-  const double ft = kt > 0.0 ? std::sqrt(target / kt) : 1.0;
-  const double fr = kr > 0.0 ? std::sqrt(target / kr) : 1.0;
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    s.v[i] *= ft;
-    s.w[i] *= fr;
-  }
+  scale_to_temperature(s, kt, kr, kT);
 }
 
 struct GrowthOptions {

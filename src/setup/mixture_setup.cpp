@@ -173,15 +173,7 @@ double rescale_to_temperature(State& s, const RigidMixture& model, double kT) {
     kt += 0.5 * m.mass * s.v[i].squaredNorm();
     kr += 0.5 * s.w[i].dot(m.apply_inertia(s.q[i], s.w[i]));
   }
-  const double target = 1.5 * double(s.size()) * kT;
-  const double ft = kt > 0.0 ? std::sqrt(target / kt) : 1.0;
-  const double fr = kr > 0.0 ? std::sqrt(target / kr) : 1.0;
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    s.v[i] *= ft;
-    s.w[i] *= fr;
-  }
-  const double after = (kt > 0.0 ? target : 0.0) + (kr > 0.0 ? target : 0.0);
-  return kt + kr - after;
+  return scale_to_temperature(s, kt, kr, kT);
 }
 
 GrowthResult grow_rigid_mixture(const SpeciesTable& species, double phi, std::uint64_t seed,

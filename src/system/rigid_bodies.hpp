@@ -72,6 +72,27 @@ inline std::string contact_reproducer(const std::string& shape_a, const BodyStat
                      body(shape_b, b), t_max);
 }
 
+// The contact of bodies i and j at a collision (states a, b at its time): the separation r_ab
+// (B's image near A) and the closest points from dist(pose_a, pose_b), the distance solve of the
+// pair's shapes; a failed solve throws, a fallback is counted.
+struct CollisionContact {
+  Vec3 r_ab;
+  DistanceResult d;
+};
+template <class Dist>
+CollisionContact collision_contact(const BodyState& a, const BodyState& b, const Box& box,
+                                   std::uint32_t i, std::uint32_t j, SolverStats& stats, Dist&& dist) {
+  CollisionContact c;
+  c.r_ab = box.near_image(b.r - a.r);
+  const Pose pa{a.r, a.q.toRotationMatrix()};
+  const Pose pb{Vec3(a.r + c.r_ab), b.q.toRotationMatrix()};
+  c.d = dist(pa, pb);
+  if (c.d.status == DistanceStatus::failed)
+    throw SolverFailure(fmt::format("distance solver failed at the collision of {} and {}", i, j));
+  if (c.d.status == DistanceStatus::fallback) ++stats.collision_distance_fallbacks;
+  return c;
+}
+
 inline double total_kinetic_energy(const State& s, const MassProperties& mass) {
   double k = 0.0;
   for (std::size_t i = 0; i < s.size(); ++i) k += hb::kinetic_energy(s.body(i), mass);
@@ -154,13 +175,9 @@ struct RigidBodies {
   CollisionRecord collide(State& s, const Box& box, std::uint32_t i, std::uint32_t j,
                           double now) const {
     BodyState a = s.body(i), b = s.body(j);  // both at `now`
-    const Vec3 r_ab = box.near_image(b.r - a.r);
-    const Pose pa{a.r, a.q.toRotationMatrix()};
-    const Pose pb{Vec3(a.r + r_ab), b.q.toRotationMatrix()};
-    const DistanceResult d = distance(shape, pa, shape, pb, options.distance);
-    if (d.status == DistanceStatus::failed)
-      throw SolverFailure(fmt::format("distance solver failed at the collision of {} and {}", i, j));
-    if (d.status == DistanceStatus::fallback) ++stats.collision_distance_fallbacks;
+    const auto [r_ab, d] = collision_contact(a, b, box, i, j, stats, [&](const Pose& pa, const Pose& pb) {
+      return distance(shape, pa, shape, pb, options.distance);
+    });
     const double rate = (b.v - a.v).norm() + (a.w.norm() + b.w.norm()) * shape.bounding_radius();
     return collide_separating(s, i, j, a, b, mass, mass, d, r_ab, 0.0, rate, stats);
   }

@@ -130,18 +130,14 @@ struct RigidMixture {
     BodyState a = s.body(i), b = s.body(j);  // both at `now`
     const double sc = law.scale_at(now), sdot = law.rate_at(now);
     const AnyShape sa = body_shape(s, i), sb = body_shape(s, j);
-    const Vec3 r_ab = box.near_image(b.r - a.r);
-    const Pose pa{a.r, a.q.toRotationMatrix()};
-    const Pose pb{Vec3(a.r + r_ab), b.q.toRotationMatrix()};
-    const DistanceResult d = std::visit(
-        [&](const auto& A, const auto& B) {
-          if (sc == 1.0) return distance(A, pa, B, pb, options.distance);
-          return distance(resized(A, sc), pa, resized(B, sc), pb, options.distance);
-        },
-        sa, sb);
-    if (d.status == DistanceStatus::failed)
-      throw SolverFailure(fmt::format("distance solver failed at the collision of {} and {}", i, j));
-    if (d.status == DistanceStatus::fallback) ++stats.collision_distance_fallbacks;
+    const auto [r_ab, d] = collision_contact(a, b, box, i, j, stats, [&](const Pose& pa, const Pose& pb) {
+      return std::visit(
+          [&](const auto& A, const auto& B) {
+            if (sc == 1.0) return distance(A, pa, B, pb, options.distance);
+            return distance(resized(A, sc), pa, resized(B, sc), pb, options.distance);
+          },
+          sa, sb);
+    });
     const double grow = std::max(0.0, (sdot / sc) * d.normal.dot(r_ab));
     const double La = bounding_radius(sa) * sc, Lb = bounding_radius(sb) * sc;
     const double rate = (b.v - a.v).norm() + a.w.norm() * La + b.w.norm() * Lb +
