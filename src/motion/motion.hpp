@@ -5,9 +5,8 @@
 //   angular_velocity(tau)                            lab frame
 //   pose(tau, q, w)                                  orientation and angular velocity at once
 //   max_angular_speed()                              a bound of |w(tau)| over all tau
-//   spherical()                                      w constant in the lab (spherical top, or
-//                                                    a body at rest / spinning on a principal axis
-//                                                    is NOT folded in: only equal moments)
+//   max_angular_acceleration()                       a bound of |dW/dtau|, W = R^T w
+//   spherical()                                      equal principal moments: w constant
 // The velocity of a body point x is v + w(tau) x (x - r(tau)); its speed relative to the centre
 // is at most max_angular_speed() times the body's bounding radius, the bound every conservative
 // step uses.
@@ -83,14 +82,6 @@ class Motion {
       q = orientation_at(b_, tau);
       w = b_.w;
     }
-  }
-  // The state at tau (the same top).
-  BodyState at(double tau) const {
-    BodyState s = b_;
-    s.r = position(tau);
-    pose(tau, s.q, s.w);
-    if (rot_) s.rot = rot_, s.rot_t = t0_ + tau;
-    return s;
   }
 
  private:
