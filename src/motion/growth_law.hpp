@@ -20,4 +20,13 @@ struct GrowthLaw {
   bool growing() const { return rate != 0.0; }
 };
 
+// The collision rule's growth term (docs/growth.md): scaling about the centre moves a surface
+// point x of a body with centre r at (s'/s)(x - r). At the contact x_C with normal n (A into B)
+// the outward normal speeds of A's and B's surfaces add up to
+//   (s'/s) n.(x_C - r_A) - (s'/s) n.(x_C - r_B) = (s'/s) n.r_AB   (r_AB = r_B - r_A),
+// >= 0 for convex bodies that contain their centres (clamped at 0 against rounding).
+inline double growth_normal_speed(double s, double sdot, const Vec3& n, const Vec3& r_ab) {
+  return std::max(0.0, (sdot / s) * n.dot(r_ab));
+}
+
 }  // namespace hb

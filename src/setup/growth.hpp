@@ -17,10 +17,10 @@
 //    streams every body to that instant, rescales v and w to the translational and rotational
 //    temperature kT, and rebuilds the Simulation (a full re-prediction: new velocities).
 //
-// GrowingRigidBodies<S> is a pair model for Simulation (same interface as RigidBodies).  Its
-// predictions cover [now, t_stop] only (contacts after t_stop are reported as none): a run
-// that continues past t_stop must re-predict every body at t_stop (grow_bodies does: it ends
-// there, and the caller continues with a plain RigidBodies simulation at the target size).
+// The pair model is RigidBodies<S> (or RigidMixture) with a growth law (`law`, motion/
+// growth_law.hpp). Its predictions cover [now, t_stop] only (contacts after t_stop are reported
+// as none): a run that continues past t_stop must re-predict every body at t_stop (grow_bodies
+// does: it ends there, and the caller continues with a rigid simulation at the target size).
 #pragma once
 #include <fmt/format.h>
 
@@ -43,77 +43,6 @@
 #include "system/state.hpp"
 
 namespace hb {
-
-template <Shape S>
-struct GrowingRigidBodies {
-  static constexpr bool kWindowed = true;  // predictions only up to the next neighbour event
-
-  S shape;  // the shape at scale 1
-  MassProperties mass;
-  GrowthLaw law;
-  double eps_d = 1e-5;
-  ContactOptions options{};
-  mutable SolverStats stats{};
-
-  // Largest centre distance at contact over the whole run: the final size.
-  double interaction_range() const {
-    return 2.0 * shape.bounding_radius() * std::max(law.s0, law.final_scale());
-  }
-  ScaleLaw scale_law(double now) const { return ScaleLaw{law.scale_at(now), law.rate_at(now)}; }
-  void prepare(State& s) const { s.tops.assign(1, mass.top()); }
-
-  void contact_times(const State& s, const Box& box, std::uint32_t i, const std::uint32_t* js,
-                     const Vec3* shifts, std::size_t n, double now, const double* horizons,
-                     double* out) const {
-    const BodyState a = s.body(i);  // body i is at `now`
-    const ScaleLaw sl = scale_law(now);
-    const double law_end = now < law.t_stop ? law.t_stop : kInf;  // the law changes there
-    double earliest = kInf;  // earliest contact found so far: later ones are not needed
-    for (std::size_t k = 0; k < n; ++k) {
-      const std::uint32_t j = js[k];
-      out[k] = kInf;
-      const double horizon = std::min({horizons ? horizons[k] : kInf, law_end, earliest});
-      if (j == i || !(horizon > now)) continue;
-      BodyState b = s.body_at(j, now);
-      b.r = shifts ? Vec3(b.r + shifts[k]) : Vec3(a.r + box.near_image(b.r - a.r));
-      ContactInput<S, S> in{shape, shape, a, b, now, now, horizon, eps_d};
-      in.growth = sl;
-      const ContactResult r = contact_time(in, options);
-      stats.add(r);
-      if (r.status == ContactStatus::failed)
-        throw SolverFailure(fmt::format(
-            "contact-time solver failed for growing bodies {} and {} at t = {:.17g} (scale "
-            "{:.17g}, rate {:.17g}); reproducer at scale 1: {}",
-            i, j, now, sl.s, sl.rate,
-            RigidBodies<S>{shape, mass, eps_d}.reproducer(a, b, horizon - now)));
-      if (r.status == ContactStatus::hit) {
-        out[k] = std::max(0.0, r.time - now);
-        earliest = std::min(earliest, r.time);
-      }
-    }
-  }
-
-  // Sum of the outward normal speeds of both surfaces at the contact (see the header).
-  static double growth_speed(double s, double sdot, const Vec3& n, const Vec3& r_ab) {
-    return std::max(0.0, (sdot / s) * n.dot(r_ab));
-  }
-
-  CollisionRecord collide(State& s, const Box& box, std::uint32_t i, std::uint32_t j,
-                          double now) const {
-    BodyState a = s.body(i), b = s.body(j);  // both at `now`
-    const double sc = law.scale_at(now), sdot = law.rate_at(now);
-    const auto shp = scaled_shape(shape, sc);
-    const auto [r_ab, d] = collision_contact(a, b, box, i, j, stats, [&](const Pose& pa, const Pose& pb) {
-      return distance(shp, pa, shp, pb, options.distance);
-    });
-    const double grow = growth_speed(sc, sdot, d.normal, r_ab);
-    const double L = shp.bounding_radius();
-    const double rate = (b.v - a.v).norm() + (a.w.norm() + b.w.norm()) * L + 2.0 * sdot / sc * L;
-    return collide_separating(s, i, j, a, b, mass, mass, d, r_ab, grow, rate, stats);
-  }
-
-  double kinetic_energy(const State& s) const { return total_kinetic_energy(s, mass); }
-};
 
 // Scale every v and every w so that the translational kinetic energy kt and the rotational one
 // kr both become 3 N kT / 2 (a zero one stays zero); returns the kinetic energy removed.
@@ -214,7 +143,8 @@ template <Shape S>
 GrowthResult grow_bodies(const S& shape, const MassProperties& mass, State st, const Box& box,
                          double s0, const GrowthOptions& opt, double eps_d = 1e-5) {
   const double t_stop = (1.0 - s0) / opt.rate;
-  GrowingRigidBodies<S> model{shape, mass, GrowthLaw{s0, opt.rate, 0.0, t_stop}, eps_d};
+  RigidBodies<S> model{shape, mass, eps_d};
+  model.law = GrowthLaw{s0, opt.rate, 0.0, t_stop};
   GrowthResult res = run_growth(std::move(model), std::move(st), box, opt, [&](State& x) {
     const double k = total_kinetic_energy(x, mass);
     rescale_to_temperature(x, mass, opt.kT);

@@ -1,6 +1,12 @@
-// Pair model of identical hard rigid bodies of any convex shape (spherical tops) for the event
-// loop: contact times from the generic solver of contact/ (paper section 2.4) within a window
-// that ends at the body's next neighbour event, and the rigid-body impulse of collision/.
+// Pair model of identical hard rigid bodies of any convex shape (any top) for the event loop:
+// contact times from the generic solver of contact/ (paper section 2.4) within a window that ends
+// at the body's next neighbour event, and the rigid-body impulse of collision/.
+//
+// Growth (Lubachevsky–Stillinger starts, setup/growth.hpp) is the growth law `law`: with
+// law.growing() every body is scaled by s(t) about its centre (the ScaleLaw decorator of the two
+// motions in contact/contact_time.hpp), predictions stop at law.t_stop (where the law changes),
+// and the collision rule gets the outward surface speed of motion/growth_law.hpp. The default
+// law is the identity, and then every prediction and collision is the rigid one, bit for bit.
 #pragma once
 #include <fmt/format.h>
 
@@ -11,6 +17,7 @@
 #include "collision/rigid.hpp"
 #include "contact/contact_time.hpp"
 #include "geometry/distance.hpp"
+#include "motion/growth_law.hpp"
 #include "shapes/codec.hpp"
 #include "system/box.hpp"
 #include "system/state.hpp"
@@ -134,7 +141,7 @@ template <Shape S>
 struct RigidBodies {
   static constexpr bool kWindowed = true;  // predictions only up to the body's next neighbour event
 
-  S shape;
+  S shape;  // at scale 1 (the target size when growing)
   MassProperties mass;
   double eps_d = 1e-5;
   ContactOptions options{};
@@ -142,8 +149,12 @@ struct RigidBodies {
   // Use the loop's per-pair horizons and stop at the earliest contact found (false: every
   // candidate is solved without any horizon; the slow twin the tests compare against).
   bool trim_horizons = true;
+  GrowthLaw law{};  // default: no growth
 
-  double interaction_range() const { return 2.0 * shape.bounding_radius(); }
+  // Largest centre distance at contact over the run (the final size when growing).
+  double interaction_range() const {
+    return 2.0 * shape.bounding_radius() * (law.growing() ? std::max(law.s0, law.final_scale()) : law.s0);
+  }
   // Bodies rotate as the top their inertia makes (motion/motion.hpp).
   void prepare(State& s) const { s.tops.assign(1, mass.top()); }
 
@@ -151,20 +162,27 @@ struct RigidBodies {
                      const Vec3* shifts, std::size_t n, double now, const double* horizons,
                      double* out) const {
     const BodyState a = s.body(i);  // body i is at `now`
-    double earliest = kInf;         // earliest contact found so far: later ones are not needed
+    const ScaleLaw sl{law.scale_at(now), law.rate_at(now)};        // {1, 0} without growth
+    const double law_end = now < law.t_stop ? law.t_stop : kInf;  // the law changes there
+    double earliest = kInf;  // earliest contact found so far: later ones are not needed
     for (std::size_t k = 0; k < n; ++k) {
       const std::uint32_t j = js[k];
       out[k] = kInf;
-      const double horizon = trim_horizons ? std::min(horizons ? horizons[k] : kInf, earliest) : kInf;
+      const double horizon =
+          trim_horizons ? std::min({horizons ? horizons[k] : kInf, law_end, earliest}) : law_end;
       if (j == i || !(horizon > now)) continue;
       BodyState b = s.body_at(j, now);
       b.r = shifts ? Vec3(b.r + shifts[k]) : Vec3(a.r + box.near_image(b.r - a.r));
       ContactInput<S, S> in{shape, shape, a, b, now, now, horizon, eps_d};
+      in.growth = sl;
       const ContactResult r = contact_time(in, options);
       stats.add(r);
       if (r.status == ContactStatus::failed)
-        throw SolverFailure(fmt::format("contact-time solver failed for bodies {} and {} at t = {:.17g}; "
-                                        "reproducer: {}", i, j, now, reproducer(a, b, horizon - now)));
+        throw SolverFailure(fmt::format(
+            "contact-time solver failed for bodies {} and {} at t = {:.17g}{}; reproducer{}: {}", i,
+            j, now,
+            law.growing() ? fmt::format(" (growth scale {:.17g}, rate {:.17g})", sl.s, sl.rate) : "",
+            law.growing() ? " at scale 1" : "", reproducer(a, b, horizon - now)));
       if (r.status == ContactStatus::hit) {
         out[k] = std::max(0.0, r.time - now);
         earliest = std::min(earliest, r.time);
@@ -175,11 +193,16 @@ struct RigidBodies {
   CollisionRecord collide(State& s, const Box& box, std::uint32_t i, std::uint32_t j,
                           double now) const {
     BodyState a = s.body(i), b = s.body(j);  // both at `now`
+    const double sc = law.scale_at(now), sdot = law.rate_at(now);
     const auto [r_ab, d] = collision_contact(a, b, box, i, j, stats, [&](const Pose& pa, const Pose& pb) {
-      return distance(shape, pa, shape, pb, options.distance);
+      if (sc == 1.0) return distance(shape, pa, shape, pb, options.distance);
+      const auto shp = scaled_shape(shape, sc);
+      return distance(shp, pa, shp, pb, options.distance);
     });
-    const double rate = (b.v - a.v).norm() + (a.w.norm() + b.w.norm()) * shape.bounding_radius();
-    return collide_separating(s, i, j, a, b, mass, mass, d, r_ab, 0.0, rate, stats);
+    const double grow = growth_normal_speed(sc, sdot, d.normal, r_ab);
+    const double L = shape.bounding_radius() * sc;
+    const double rate = (b.v - a.v).norm() + (a.w.norm() + b.w.norm()) * L + 2.0 * sdot / sc * L;
+    return collide_separating(s, i, j, a, b, mass, mass, d, r_ab, grow, rate, stats);
   }
 
   double kinetic_energy(const State& s) const { return total_kinetic_energy(s, mass); }

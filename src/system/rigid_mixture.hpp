@@ -138,7 +138,7 @@ struct RigidMixture {
           },
           sa, sb);
     });
-    const double grow = std::max(0.0, (sdot / sc) * d.normal.dot(r_ab));
+    const double grow = growth_normal_speed(sc, sdot, d.normal, r_ab);
     const double La = bounding_radius(sa) * sc, Lb = bounding_radius(sb) * sc;
     const double rate = (b.v - a.v).norm() + a.w.norm() * La + b.w.norm() * Lb +
                         (sdot / sc) * (La + Lb);
