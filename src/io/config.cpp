@@ -622,7 +622,8 @@ std::string config_reference() {
          "| `polydispersity` | table | none | `{ distribution = \"gaussian\" or \"uniform\", width = w }`: body sizes scaled by s with mean 1 and relative standard deviation w in (0, 0.3) (gaussian truncated at 3 w); mass scales as s^3, inertia as s^5 |\n"
          "\nMixtures (and polydisperse bodies) start from a random placement at `init.phi0` (lower if the\n"
          "bodies' bounding spheres would fill more than a quarter of the box) grown to\n"
-         "`system.packing_fraction` (at most 0.6), and use cell lists. Any shapes may be mixed; a body\n"
+         "`system.packing_fraction` (at most 0.6). Non-spherical mixtures take either neighbour method\n"
+         "(per-body boxes with NNL); sphere mixtures use cell lists. Any shapes may be mixed; a body\n"
          "whose principal moments differ rotates as the exact free symmetric or asymmetric top.\n";
   return out;
 }

@@ -27,6 +27,11 @@
 // 8 * circumradius / K (K the body's speed bound; a spinning body may never leave), a rebuild is
 // scheduled at the end of that window anyway (harmless: a rebuild at any time is valid).
 //
+// Mixtures (ObbNeighbors<AnyShape>): body i is the shape of its species resized by its scale
+// (State::species, State::scale; shapes/registry.hpp `resized`). Its box extents, escape margin
+// and speed bound are those of that body; the cell list over box centres is sized by the largest
+// box (every species at its largest scale), so overlapping boxes still sit in adjacent cells.
+//
 // Positions: at its rebuild the body's stored position is wrapped into the periodic box (image
 // counter updated), so the box centres lie in [0, L); list entries are ids and the pair code
 // uses the near image (needs_minimum_image() is true). The minimum-image SAT is exact when every
@@ -36,6 +41,8 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <type_traits>
+#include <variant>
 #include <vector>
 
 #include "contact/escape_time.hpp"
@@ -43,6 +50,7 @@
 #include "geometry/obb.hpp"
 #include "neighbors/cell_list.hpp"
 #include "neighbors/shell_neighbors.hpp"
+#include "shapes/registry.hpp"
 #include "shapes/shape.hpp"
 #include "system/box.hpp"
 #include "system/state.hpp"
@@ -57,21 +65,55 @@ struct ObbSnapshot {
   std::vector<Vec3> half;
 };
 
+// The shapes ObbNeighbors works with: one support shape for every body, or AnyShape (a mixture).
+template <class S>
+concept ObbBodyShape = SupportShape<S> || std::is_same_v<S, AnyShape>;
+
+// Extents of a shape along its own axes (the half-extents of the smallest body-aligned box
+// around it; the max with the support values guards shapes whose half_extents are loose).
 template <SupportShape S>
+Vec3 obb_extents(const S& shape) {
+  Vec3 ext;
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 e = Vec3::Unit(k);
+    ext[k] = std::max({shape.half_extents()[k], shape.support(e), shape.support(Vec3(-e))});
+  }
+  return ext;
+}
+
+template <ObbBodyShape S>
 class ObbNeighbors {
+  static constexpr bool kMixture = std::is_same_v<S, AnyShape>;
+
  public:
   static constexpr EventType kEventType = EventType::Rebuild;
 
-  ObbNeighbors(const S& shape, double shell) : shape_(shape), shell_(shell) {
-    if (!(shell > 0.0)) throw std::invalid_argument("neighbour-list shell must be positive");
-    for (int k = 0; k < 3; ++k) {
-      const Vec3 e = Vec3::Unit(k);
-      ext_[k] = std::max({shape.half_extents()[k], shape.support(e), shape.support(Vec3(-e))});
-    }
-    margin_ = std::min(0.01 * shape.inscribed_radius(), 0.25 * shell);
+  // Every body has `shape`.
+  ObbNeighbors(const S& shape, double shell)
+    requires(!kMixture)
+      : shape_(shape), shell_(shell) {
+    check_shell(shell);
+    ext_ = obb_extents(shape);
+    margin_ = body_margin(shape.inscribed_radius());
     eps_ = margin_;
     rc_ = (ext_.array() + shell_).matrix().norm();
     kbound_l_ = shape.bounding_radius();
+  }
+  // A mixture: body i is species_shapes[species_i] resized by scale_i <= max_scale[species_i].
+  ObbNeighbors(const std::vector<AnyShape>& species_shapes, const std::vector<double>& max_scale,
+               double shell)
+    requires kMixture
+      : shell_(shell) {
+    check_shell(shell);
+    if (species_shapes.empty() || species_shapes.size() != max_scale.size())
+      throw std::invalid_argument("ObbNeighbors: one shape and one largest scale per species");
+    for (std::size_t k = 0; k < species_shapes.size(); ++k) {
+      Kind kind{species_shapes[k], Vec3::Zero(), inscribed_radius(species_shapes[k]),
+                bounding_radius(species_shapes[k])};
+      kind.ext = std::visit([](const auto& x) { return obb_extents(x); }, species_shapes[k]);
+      kinds_.push_back(kind);
+      rc_ = std::max(rc_, (kind.ext.array() * max_scale[k] + shell_).matrix().norm());
+    }
   }
 
   void init(const Box& box, State& s, double now) {
@@ -79,7 +121,7 @@ class ObbNeighbors {
     for (std::uint32_t i = 0; i < s.size(); ++i) {
       s.advance_to(i, now);
       s.image[i] += box.wrap(s.r[i]);
-      set_box(i, s.r[i], s.q[i], Vec3(ext_.array() + shell_));
+      set_box(i, s.r[i], s.q[i], half_extents_of(s, i));
       cells_.insert(i, obb_[i].centre);
     }
     build_all(box);
@@ -128,11 +170,30 @@ class ObbNeighbors {
     Event e;
     e.owner = i;
     const BodyState b = s.body(i);
-    const double K = b.v.norm() + b.w.norm() * kbound_l_;
-    if (K == 0.0) return e;  // at rest: never leaves
-    const double t_cap = now + 8.0 * rc_ / K;
-    EscapeInput<S> in{shape_, b, s.t[i], now, t_cap, obb_[i], margin_, eps_};
-    const EscapeResult r = escape_time(in);
+    if constexpr (kMixture) {
+      const Kind& kind = kinds_[s.species[i]];
+      const double sc = s.scale[i];
+      const double K = b.v.norm() + b.w.norm() * kind.bound * sc;
+      if (K == 0.0) return e;  // at rest: never leaves
+      const double t_cap = now + 8.0 * obb_[i].half.norm() / K;
+      const double margin = body_margin(kind.inscribed * sc);
+      const AnyShape shape = sc == 1.0 ? kind.shape : resized(kind.shape, sc);
+      return escape_event(e, now, t_cap, std::visit([&](const auto& x) {
+        EscapeInput<std::decay_t<decltype(x)>> in{x, b, s.t[i], now, t_cap, obb_[i], margin, margin};
+        return escape_time(in);
+      }, shape));
+    } else {
+      const double K = b.v.norm() + b.w.norm() * kbound_l_;
+      if (K == 0.0) return e;  // at rest: never leaves
+      const double t_cap = now + 8.0 * rc_ / K;
+      EscapeInput<S> in{shape_, b, s.t[i], now, t_cap, obb_[i], margin_, eps_};
+      return escape_event(e, now, t_cap, escape_time(in));
+    }
+  }
+
+ private:
+  // The neighbour event of an escape search `r` (window [now, t_cap]).
+  Event escape_event(Event e, double now, double t_cap, const EscapeResult& r) const {
     if (r.truncated) ++truncated_;
     e.type = kEventType;
     switch (r.status) {
@@ -151,6 +212,8 @@ class ObbNeighbors {
     }
     return e;
   }
+
+ public:
 
   // Rebuild body i's box around its current pose (body already streamed to the event time) and
   // update the lists it appears in. Returns false: predict i against its whole new list.
@@ -177,6 +240,17 @@ class ObbNeighbors {
   }
 
  private:
+  static void check_shell(double shell) {
+    if (!(shell > 0.0)) throw std::invalid_argument("neighbour-list shell must be positive");
+  }
+  // Escape margin and grazing step of a body of inscribed radius r_in (see the header).
+  double body_margin(double r_in) const { return std::min(0.01 * r_in, 0.25 * shell_); }
+  // Half-extents of body i's box: its extents at its scale plus the shell.
+  Vec3 half_extents_of(const State& s, std::uint32_t i) const {
+    if constexpr (kMixture) return Vec3(kinds_[s.species[i]].ext.array() * s.scale[i] + shell_);
+    else return Vec3(ext_.array() + shell_);
+  }
+
   void setup(const Box& box, std::size_t n) {
     const double reach = 2.0 * rc_;
     const double rho = double(n) / box.volume();
@@ -203,11 +277,20 @@ class ObbNeighbors {
     });
   }
 
-  S shape_;
+  // A species of a mixture at scale 1.
+  struct Kind {
+    AnyShape shape;
+    Vec3 ext;          // extents along its axes
+    double inscribed;  // inscribed radius
+    double bound;      // bounding radius
+  };
+
+  S shape_{};                // one shape (not a mixture)
+  std::vector<Kind> kinds_;  // a mixture's species
   double shell_;
   Vec3 ext_ = Vec3::Ones();  // body extents along its axes (max of half_extents and support)
   double margin_ = 0.0, eps_ = 0.0;
-  double rc_ = 0.0;          // box circumradius
+  double rc_ = 0.0;          // box circumradius (a mixture: the largest)
   double kbound_l_ = 0.0;    // bounding radius (speed bound of the body's points)
   CellList cells_;           // over box centres; changes only at rebuilds
   std::vector<Obb> obb_;

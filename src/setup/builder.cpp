@@ -53,9 +53,6 @@ HardSphereMixture plan_sphere_mixture(const Config& c) {
 }
 
 RigidMixture plan_rigid_mixture(const Config& c) {
-  if (c.neighbors_method != "cells")
-    throw ConfigError(fmt::format("{}: key 'neighbors.method': mixtures and polydisperse bodies "
-                                  "use cell lists (\"cells\") so far", c.source));
   RigidMixture m = RigidMixture::of(c.species, c.eps_d);
   check_mixture_box(c, m.interaction_range());
   return m;

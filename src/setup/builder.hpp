@@ -228,7 +228,8 @@ void assemble_rigid(const Config& c, const S& shape, F&& f) {
 }
 
 // Mixtures with non-spherical species, and polydisperse non-spherical bodies: the generic
-// RigidMixture over cell lists, started by random placement and growth of every body.
+// RigidMixture over cell lists or per-body oriented-box lists, started by random placement and
+// growth of every body.
 template <class F>
 void assemble_rigid_mixture(const Config& c, F&& f) {
   const RigidMixture model = plan_rigid_mixture(c);
@@ -244,7 +245,11 @@ void assemble_rigid_mixture(const Config& c, F&& f) {
       std::fprintf(stderr, "hardbody: placing at phi <= %g, growing to %g (rate %g) ...\n", go.phi0, phi, go.rate);
     return grown_start(grow_rigid_mixture(species, phi, seed, go, eps_d), go, check, seed);
   };
-  f(Assembly<RigidMixture, CellNeighbors>(model, CellNeighbors(model.interaction_range()), ops, start));
+  if (c.neighbors_method == "nnl")
+    f(Assembly<RigidMixture, ObbNeighbors<AnyShape>>(
+        model, ObbNeighbors<AnyShape>(model.shape, model.max_scale, c.shell), ops, start));
+  else
+    f(Assembly<RigidMixture, CellNeighbors>(model, CellNeighbors(model.interaction_range()), ops, start));
 }
 
 }  // namespace builder_detail

@@ -340,3 +340,36 @@ def test_mixture_resume_reproduces_uninterrupted_run(tmp_path):
     assert_resume_reproduces(tmp_path, MIXTURE.format(time=30.0), 0.6,
                              ["collisions", "Z", "energy_drift", "overlaps", "min_distance",
                               "packing_fraction", "species", "species_pairs"])
+
+
+RIGID_MIXTURE = """
+[system]
+packing_fraction = 0.3
+seed = 6
+[[species]]
+name = "S"
+count = 100
+shape = {{ type = "sphere", radius = 0.45 }}
+[[species]]
+name = "E"
+count = 100
+shape = {{ type = "ellipsoid", semi_axes = [1.0, 0.5, 0.4] }}
+polydispersity = {{ distribution = "gaussian", width = 0.08 }}
+[neighbors]
+method = "{method}"
+[run]
+equilibrate_time = 0.5
+time = {time}
+[output]
+log_interval = 0.5
+snapshot_interval = 1.0
+checkpoint_interval = 0.2
+"""
+
+
+@pytest.mark.parametrize("method", ["cells", "nnl"])
+def test_rigid_mixture_resume_reproduces_uninterrupted_run(tmp_path, method):
+    """A polydisperse sphere-ellipsoid mixture (asymmetric tops) with either neighbour method."""
+    assert_resume_reproduces(tmp_path, RIGID_MIXTURE.format(method=method, time=6.0), 1.5,
+                             ["collisions", "Z", "energy_drift", "overlaps", "min_distance",
+                              "packing_fraction", "species", "neighbors"])
