@@ -41,7 +41,11 @@
 //     lambda), so h_K(n) >= m_j if m_j >= 0, else m_j / nu; the best j gives a lower bound of
 //     h_K over the cell, i.e. an upper bound U of G there.  (First-order in the support points,
 //     so U exceeds max G over the cell by ~ R rho^2, rho the cell size, R the largest radius of
-//     curvature.)  The cell with the largest U is split first; cells with U <= best + tol are
+//     curvature.)  Tighter with a rolling ball: if a ball of radius r_A rolls freely inside A
+//     (every principal radius of curvature >= r_A, Blaschke; for an ellipsoid r_A =
+//     min(a,b,c)^2 / max(a,b,c)), A = A' + ball(r_A), so K = K' + ball(r), r = r_A + r_B, with
+//     h_K = h_K' + r and w_K'(n) = w(n) - r n: the bound is applied to K' and r added back.
+//     A sphere pair is then bounded exactly (K' is a point), nearly round bodies nearly so.  The cell with the largest U is split first; cells with U <= best + tol are
 //     dropped.  When the largest U is within tol of the best G found, d is certified:
 //     best <= d <= best + tol.  Every vertex whose G beats the best seen is refined (step 3).
 //     A landscape that is flat over a large region (coincident spheres, or needles lying side
@@ -73,6 +77,7 @@
 #include "math/types.hpp"
 #include "shapes/registry.hpp"
 #include "shapes/shape.hpp"
+#include "shapes/superquadric.hpp"
 
 namespace hb {
 
@@ -175,7 +180,7 @@ double refine(const Gp& S, Vec3& n, double scale, int max_iter) {
 
 struct Vertex {
   Vec3 n;  // unit direction
-  Vec3 w;  // support point of K = A - B along n
+  Vec3 w;  // support point of K' along n: that of K = A - B minus r n (rolling ball, header)
   double G;
 };
 
@@ -185,7 +190,21 @@ struct Cell {
   bool operator<(const Cell& o) const { return upper < o.upper; }  // max-heap on the bound
 };
 
-inline double cell_upper(const Vertex& p, const Vertex& q, const Vertex& r, double margin) {
+// Radius of a ball that rolls freely inside the shape (0: no claim).
+inline double rolling_radius(const Sphere& s) { return s.radius; }
+inline double rolling_radius(const Ellipsoid& e) {
+  const double mn = std::min({e.a, e.b, e.c}), mx = std::max({e.a, e.b, e.c});
+  return mn * mn / mx;
+}
+inline double rolling_radius(const Superquadric& q) {
+  return q.n == 2.0 && q.m == 2.0 && q.p == 2.0 ? rolling_radius(Ellipsoid{q.a, q.b, q.c}) : 0.0;
+}
+template <class S>
+double rolling_radius(const S&) { return 0.0; }
+
+// Upper bound of G over the cell; the vertices carry w' = w - r n (support points of K').
+inline double cell_upper(const Vertex& p, const Vertex& q, const Vertex& r, double roll,
+                         double margin) {
   const Vertex* V[3] = {&p, &q, &r};
   const Vec3 c = (p.n + q.n + r.n).normalized();
   const double nu = std::min({p.n.dot(c), q.n.dot(c), r.n.dot(c)});
@@ -195,7 +214,7 @@ inline double cell_upper(const Vertex& p, const Vertex& q, const Vertex& r, doub
     for (const Vertex* vi : V) m = std::min(m, vj->w.dot(vi->n));
     lower_h = std::max(lower_h, m >= 0.0 ? m : m / nu);
   }
-  return -lower_h + margin;
+  return -(lower_h + roll) + margin;
 }
 
 }  // namespace penetration_detail
@@ -213,6 +232,7 @@ PenetrationResult penetration(const SA& a, const Pose& pa, const SB& b, const Po
   const double tol = o.rel_tol * l;
   // G and w carry rounding of order 1e-16 scale; the bound is widened by far more than that.
   const double margin = 1e-13 * scale;
+  const double roll = rolling_radius(a) + rolling_radius(b);
 
   PenetrationResult res;
   Vec3 best_n = Vec3::UnitX();
@@ -256,7 +276,7 @@ PenetrationResult penetration(const SA& a, const Pose& pa, const SB& b, const Po
     const Vec3 n = dir.normalized();
     Vec3 xa, xb;
     S.points(n, xa, xb);
-    V.push_back(Vertex{n, xa - xb, n.dot(xb - xa)});
+    V.push_back(Vertex{n, xa - xb - roll * n, n.dot(xb - xa)});
     const int id = int(V.size()) - 1;
     if (V[id].G > best) {
       if (res.refines < o.max_refines) local(n);
@@ -278,7 +298,7 @@ PenetrationResult penetration(const SA& a, const Pose& pa, const SB& b, const Po
   };
   std::priority_queue<Cell> cells;
   auto push = [&](int i, int j, int k) {
-    const Cell c{{i, j, k}, cell_upper(V[i], V[j], V[k], margin)};
+    const Cell c{{i, j, k}, cell_upper(V[i], V[j], V[k], roll, margin)};
     if (c.upper > best + tol) cells.push(c);
   };
   int oct[6];

@@ -154,6 +154,12 @@ TEST(Penetration, CoincidentBodies) {
   EXPECT_NEAR(penetration(cube, p0, cube, p0).distance, -0.8, 1e-9);
   const Sphere s{0.6};
   EXPECT_NEAR(penetration(s, p0, tri, p0).distance, -1.1, 1e-12);
+  // flat landscapes: certified through the rolling ball (G is constant for coincident spheres)
+  EXPECT_TRUE(penetration(s, p0, s, p0).certified);
+  const PenetrationResult se = penetration(s, p0, Ellipsoid{1.0, 1.0, 1.0}, p0);
+  EXPECT_NEAR(se.distance, -1.6, 1e-12);
+  EXPECT_TRUE(se.certified);
+  std::printf("  coincident sphere and unit ellipsoid: %d evaluations\n", se.evaluations);
 }
 
 TEST(Penetration, ParallelNeedlesAndCubes) {
