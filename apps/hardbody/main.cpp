@@ -11,6 +11,7 @@
 #include "io/convert.hpp"
 #include "io/pair_query.hpp"
 
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include "io/run.hpp"
@@ -39,7 +40,9 @@ int main(int argc, char** argv) {
   cmd_dist->add_option("file", dist_file, "JSON-lines input (default stdin)");
   auto* cmd_ct = app.add_subcommand("contact-time", "first contact time of moving pairs (JSON lines)");
   cmd_ct->add_option("file", ct_file, "JSON-lines input (default stdin)");
-  cmd_ct->add_option("--eps-d", ct_eps, "distance accuracy epsilon_d")->check(CLI::PositiveNumber);
+  // (range checked by contact_time_queries against each pair's size, with a readable message:
+  // CLI::PositiveNumber printed DBL_MAX in 309 digits)
+  cmd_ct->add_option("--eps-d", ct_eps, "distance accuracy epsilon_d (a length, default 1e-5)");
 
   auto* cmd_ref = app.add_subcommand("config-reference", "print the reference of every config key (docs/config.md)");
 
@@ -58,6 +61,9 @@ int main(int argc, char** argv) {
     if (cmd_ref->parsed()) std::cout << hb::config_reference();
     auto lines = [](const std::string& file, auto&& fn) {
       if (file.empty()) return fn(std::cin, std::string("<stdin>"));
+      // (an ifstream opens a directory, and its first read fails like an empty file's end)
+      if (std::filesystem::is_directory(file))
+        throw hb::InputError(file + ": is a directory, not a JSON-lines file");
       std::ifstream in(file);
       if (!in) throw hb::InputError(file + ": cannot open");
       return fn(in, file);
