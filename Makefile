@@ -21,7 +21,7 @@ test: build build-debug
 	cd build && ctest -j $(JOBS) --output-on-failure
 
 example: build
-	./build/apps/hardbody/hardbody run examples/hard-spheres.toml --out run-hard-spheres
+	./build/apps/hardbody/hardbody run examples/hard-spheres.toml --out run-hard-spheres --overwrite
 
 bench: build
 	./scripts/bench.sh

@@ -109,7 +109,7 @@ run() {
   fi
   rm -rf "$work/$name"
   echo "== $name ($(date -u +%H:%M:%S))" >&2
-  nice -n "$nice_level" "$HB" run "$work/$name.toml" --out "$work/$name" --quiet \
+  nice -n "$nice_level" "$HB" run "$work/$name.toml" --out "$work/$name" --overwrite --quiet \
     2> "$work/$name.stderr"
   rc=$?
   if [ $rc -eq 0 ]; then

@@ -24,8 +24,13 @@ int main(int argc, char** argv) {
   auto* cmd_run = app.add_subcommand("run", "run a simulation from a TOML config");
   cmd_run->add_option("config", run.config_path, "configuration file (TOML)")->required();
   cmd_run->add_option("--out", run.out_dir, "output directory (default ./run-<config stem>)");
-  cmd_run->add_option("--set", run.overrides, "override a key: section.key=value")->take_all();
+  // one value per --set (a config path after `--set k=v` once was swallowed as another value)
+  cmd_run->add_option("--set", run.overrides, "override a key: section.key=value (repeat for more)")
+      ->expected(1)
+      ->allow_extra_args(false)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   cmd_run->add_flag("--resume", run.resume, "continue from checkpoint.gsd in the output directory");
+  cmd_run->add_flag("--overwrite", run.overwrite, "replace a previous run in the output directory");
   cmd_run->add_flag("--quiet", run.quiet, "no progress line");
 
   std::string conv_in, conv_out, conv_to = "xyz";
@@ -57,7 +62,10 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : 2;
   }
   try {
-    if (cmd_run->parsed()) hb::run_simulation(run);
+    if (cmd_run->parsed()) {
+      run.out_given = cmd_run->get_option("--out")->count() > 0;
+      hb::run_simulation(run);
+    }
     if (cmd_ref->parsed()) std::cout << hb::config_reference();
     auto lines = [](const std::string& file, auto&& fn) {
       if (file.empty()) return fn(std::cin, std::string("<stdin>"));

@@ -76,6 +76,19 @@ ConfigSignature config_signature(const Config& c) {
   w.add("neighbors.method", c.neighbors_method == "cells" ? 0 : 1);
   w.add("neighbors.shell", c.shell);
   w.add("solver.eps_d", c.eps_d);
+  // The keys that shape the measured stretch and its summary: a resume that changed one would
+  // describe a different run (run.time and run.max_collisions may grow: that extends the run).
+  w.add("run.equilibrate_time", c.equilibrate_time);
+  w.add("output.log_interval", c.log_interval);
+  w.add("output.snapshot_interval", c.snapshot_interval);
+  w.add("output.trajectory", c.trajectory ? 1.0 : 0.0);
+  w.add("observables.interval", c.obs_interval);
+  w.add("observables.origin_every", double(c.obs_origin_every));
+  w.add("observables.max_lag", c.obs_max_lag);
+  w.add("observables.q", c.obs_q);
+  w.add("observables.q_vectors", double(c.obs_q_vectors));
+  w.add("observables.gr_interval", c.gr_interval);
+  w.add("observables.gr_bins", double(c.gr_bins));
   return std::move(w.sig);
 }
 
@@ -210,13 +223,19 @@ Reader open(const std::string& path, const Config& c) {
   }
   const auto sig = r.row("hardbody/config");
   const ConfigSignature want = config_signature(c);
-  for (std::size_t k = 0; k < std::min(want.values.size(), sig.size()); ++k)
-    if (sig[k] != want.values[k])
-      throw InputError(fmt::format(
-          "{}: checkpoint was written with a different configuration ({} = {} there, {} in {})",
-          path, want.names[k], sig[k], want.values[k], c.source));
   if (sig.size() != want.values.size())
-    throw InputError(fmt::format("{}: checkpoint from an incompatible hardbody version", path));
+    throw InputError(fmt::format("{}: checkpoint from an incompatible hardbody version (its config "
+                                 "record has {} keys, this version writes {})",
+                                 path, sig.size(), want.values.size()));
+  std::string changed;  // every key that differs, not only the first
+  for (std::size_t k = 0; k < sig.size(); ++k)
+    if (sig[k] != want.values[k])
+      changed += fmt::format("{}{} = {} there, {} now", changed.empty() ? "" : "; ", want.names[k],
+                             sig[k], want.values[k]);
+  if (!changed.empty())
+    throw InputError(fmt::format(
+        "{}: checkpoint was written with a different configuration ({}; config {}); a resume "
+        "may only extend run.time or run.max_collisions", path, changed, c.source));
   if (r.f.N != c.particles)
     throw InputError(fmt::format("{}: checkpoint has {} particles, config {}", path, r.f.N, c.particles));
   return r;

@@ -37,7 +37,7 @@ const std::vector<KeySpec>& key_specs() {
       {"run", "equilibrate_time", Kind::Float, "simulated time run and discarded before measuring"},
       {"run", "time", Kind::Float, "simulated time measured (required)"},
       {"run", "max_collisions", Kind::Int, "stop the measured run after this many collisions (0: no limit)"},
-      {"neighbors", "method", Kind::String, "\"cells\" or \"nnl\" (oriented-box / sphere-shell neighbour lists); default cells for spheres, nnl otherwise; mixtures use cells"},
+      {"neighbors", "method", Kind::String, "\"cells\" or \"nnl\" (oriented-box / sphere-shell neighbour lists); default cells when every species is a sphere, nnl otherwise; sphere mixtures use cells"},
       {"neighbors", "shell", Kind::Float, "Delta_NNL: the neighbour-list shell (a length)"},
       {"solver", "eps_d", Kind::Float, "the paper's epsilon_d: the distance accuracy of the contact-time search"},
       {"output", "log_interval", Kind::Float, "simulated time per log.tsv row and per pressure block"},
@@ -446,9 +446,13 @@ Config validate(const std::string& file, const toml::table& root) {
   }
   if (c.equilibrate_time < 0.0) bad("run", "equilibrate_time", "must not be negative");
   if (!(c.time > 0.0)) bad("run", "time", "must be positive");
-  // cells for spheres (their analytic contact times are cheap), neighbour lists otherwise
-  if (!r.get("neighbors", "method"))
-    c.neighbors_method = std::holds_alternative<Sphere>(c.species[0].shape) ? "cells" : "nnl";
+  // cells for spheres (their analytic contact times are cheap), neighbour lists as soon as one
+  // species is not a sphere (whichever species comes first)
+  if (!r.get("neighbors", "method")) {
+    c.neighbors_method = "cells";
+    for (const Species& sp : c.species)
+      if (!std::holds_alternative<Sphere>(sp.shape)) c.neighbors_method = "nnl";
+  }
   if (c.neighbors_method != "cells" && c.neighbors_method != "nnl")
     bad("neighbors", "method", fmt::format("must be \"cells\" or \"nnl\" (got \"{}\")", c.neighbors_method));
   if (!(c.shell > 0.0)) bad("neighbors", "shell", "must be positive");

@@ -18,6 +18,7 @@
 #include "io/files.hpp"
 #include "io/gsd_hoomd.hpp"
 #include "io/progress.hpp"
+#include "io/run_directory.hpp"
 #include "io/shape_io.hpp"
 #include "observers/correlations.hpp"
 #include "observers/structure.hpp"
@@ -62,19 +63,22 @@ class LogTable {
  public:
   static constexpr const char* kHeader =
       "time\tcollisions\tZ_block\tZ_mean\ttemperature\tenergy_drift\tcollision_rate\n";
-  // Opens the table keeping the first `keep_rows` data rows of an existing .part file.
+  // Opens the table keeping the first `keep_rows` data rows of an existing .part file, or of the
+  // committed table when the run had finished (a kill between the commit and summary.json, or a
+  // finished run being extended).
   LogTable(std::string path, std::uint64_t keep_rows, bool resume)
       : path_(std::move(path)), part_(path_ + ".part") {
     std::string kept = kHeader;
     if (resume) {
-      std::ifstream in(part_);
+      const std::string from = file_exists(part_) || !file_exists(path_) ? part_ : path_;
+      std::ifstream in(from);
       if (!in && keep_rows > 0)
         throw InputError(fmt::format("{}: missing; it holds the log rows before the checkpoint", part_));
       std::string line;
       std::getline(in, line);  // header
       for (std::uint64_t k = 0; k < keep_rows; ++k) {
         if (!std::getline(in, line))
-          throw InputError(fmt::format("{}: has fewer rows than the checkpoint records", part_));
+          throw InputError(fmt::format("{}: has fewer rows than the checkpoint records", from));
         kept += line + "\n";
       }
     }
@@ -131,6 +135,30 @@ void truncate_trajectory(const std::string& path, std::uint64_t frames) {
     w.close();
   }
   std::filesystem::rename(tmp, path);
+}
+
+// Has the measured run reached its end (run.time or run.max_collisions)?
+template <class Sim>
+bool run_finished(const Sim& sim, const Config& cfg, const DriverState& d) {
+  if (d.phase < 1) return false;
+  if (!(sim.now() < cfg.equilibrate_time + cfg.time)) return true;
+  return cfg.max_collisions && double(sim.collisions()) - d.coll0 >= double(cfg.max_collisions);
+}
+
+// A restored state must be one a run can reach: finite and without overlaps.
+template <class Sim>
+void check_restored(const Sim& sim, const SystemOps& ops, const std::string& path) {
+  const State& s = sim.state();
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const bool ok = s.r[i].allFinite() && s.v[i].allFinite() && s.w[i].allFinite() &&
+                    s.q[i].coeffs().allFinite() && std::isfinite(s.t[i]) && std::isfinite(s.scale[i]);
+    if (!ok) throw InputError(fmt::format("{}: body {} has a non-finite position, orientation, velocity or time", path, i));
+  }
+  const auto rep = ops.overlaps(synchronized_state(sim), sim.box());
+  if (rep.overlaps > 0)
+    throw InputError(fmt::format("{}: holds {} overlapping pairs (min gap {:.3g}); no run reaches such a "
+                                 "state: the file is damaged or not this run's", path, rep.overlaps,
+                                 rep.min_distance));
 }
 
 class Interrupted : public std::runtime_error {
@@ -191,6 +219,7 @@ class Driver {
         writer.emplace(gsd::HoomdWriter::create(traj));
       }
     }
+    if (st_.phase == 2 && !run_finished(sim_, cfg_, st_)) st_.phase = 1;  // extended: measure on
     const double cpu0 = cpu_seconds();
     last_checkpoint_ = progress_.wall_seconds();
     auto measured_cpu = [&] { return st_.cpu_prev + (st_.phase == 1 ? cpu_seconds() - cpu_mark_ : 0.0); };
@@ -223,7 +252,7 @@ class Driver {
         snapshot_min_gap_ = std::min(snapshot_min_gap_, rep.min_distance);
       }
       if (st_.phase == 1) sample_observables();
-      const double block_end = st_.phase == 0 ? t_eq : std::min(t_end, st_.block_start + cfg_.log_interval);
+      const double block_end = st_.phase == 0 ? t_eq : log_block_end(st_.block_start, t_end);
       double target = block_end;
       if (st_.phase == 1 && writer) target = std::min(target, st_.next_snapshot);
       if (st_.phase == 1 && cfg_.obs_interval > 0.0) target = std::min(target, st_.next_corr);
@@ -254,6 +283,13 @@ class Driver {
                 pressure_.collision_rate().mean);
         st_.log_rows += 1;
         if (sim_.now() >= t_end || limit) {
+          if (writer) {  // the final state is the last frame (the grid's frames are all earlier)
+            writer->write_frame(make_frame(sim_, cfg_.species, false, nullptr));
+            writer->sync();
+            st_.frames += 1;
+            // a grid time at the end is this frame (an extended run does not repeat it)
+            if (!(st_.next_snapshot > sim_.now())) st_.next_snapshot += cfg_.snapshot_interval;
+          }
           st_.cpu_prev = measured_cpu();
           st_.wall_prev += progress_.wall_seconds() - wall_mark_;
           wall_mark_ = progress_.wall_seconds();
@@ -318,6 +354,13 @@ class Driver {
   void housekeeping() {
     if (const int sig = g_signal.load()) throw Interrupted(sig);
     if (progress_.wall_seconds() - last_checkpoint_ >= cfg_.checkpoint_interval) write_checkpoint();
+  }
+  // End of the log block that starts at t0: one log interval later, or the end of the run. A
+  // remainder within rounding of zero joins this block: intervals that are not exact in binary
+  // (0.1) once left a last block of length ~1e-16 whose Z_block = 1 inflated Z_error.
+  double log_block_end(double t0, double t_end) const {
+    const double t = t0 + cfg_.log_interval;
+    return t_end - t <= 1e-9 * cfg_.log_interval ? t_end : t;
   }
   bool partial_gr() const { return cfg_.species.size() > 1; }
   double energy() const { return ops_.kinetic(sim_.state()); }
@@ -422,7 +465,7 @@ class Driver {
     j["collisions_per_second"] = cpu > 0 ? double(ncoll) / cpu : 0.0;
     j["tau_c_us"] = ncoll > 0 ? 1e6 * cpu / double(ncoll) : 0.0;
     j["Z"] = Z.mean;
-    j["Z_error"] = Z.error;
+    j["Z_error"] = Z.error;  // NaN -> null: unknown (fewer than 2 log blocks)
     j["Z_blocks"] = Z.blocks;
     j["collision_rate"] = rate.mean;
     j["collision_rate_error"] = rate.error;
@@ -486,13 +529,20 @@ class Driver {
       write_file_atomic(dir_ + "/gr_partial.tsv", gr_partial_.to_tsv(names));
     }
     write_file_atomic(dir_ + "/nematic.tsv", nem_.to_tsv());
+    if (!Z.error_known())
+      j["notes"].push_back(fmt::format(
+          "Z_error, collision_rate_error and the temperature errors are null (unknown): the "
+          "measured run has {} log block(s), the block error needs at least 2 (run.time / "
+          "output.log_interval >= 2)", Z.blocks));
     for (const auto& [k, v] : extra_.items()) j[k] = v;
     log.commit();
     write_file_atomic(dir_ + "/summary.json", j.dump(2) + "\n");
     if (!opt_.quiet)
-      std::fprintf(stderr, "hardbody: %s: t=%.6g collisions=%llu Z=%.5f +- %.5f overlaps=%llu -> %s\n",
+      std::fprintf(stderr, "hardbody: %s: t=%.6g collisions=%llu Z=%.5f +- %s overlaps=%llu -> %s\n",
                    cfg_.source.c_str(), pressure_.measured_time(), (unsigned long long)ncoll, Z.mean,
-                   Z.error, (unsigned long long)rep.overlaps, dir_.c_str());
+                   Z.error_known() ? fmt::format("{:.5f}", Z.error).c_str()
+                                   : "unknown (fewer than 2 log blocks)",
+                   (unsigned long long)rep.overlaps, dir_.c_str());
     if (rep.overlaps > 0 || snapshot_overlaps_ > 0)
       throw RunFailure(fmt::format("{} overlapping pairs in the final state (min gap {:.3g}), {} in snapshots",
                                    rep.overlaps, rep.min_distance, snapshot_overlaps_));
@@ -558,15 +608,32 @@ nlohmann::json init_json(const StartInfo& i) {
           {"min_distance_after_growth", g.overlaps.min_distance}};
 }
 
-// Starts a new run from the assembly's start, or resumes from the checkpoint.
+// Starts a new run from the assembly's start, or resumes from the checkpoint (a finished run is
+// left alone, or extended when run.time or run.max_collisions grew).
 template <class A>
-void start_or_resume(const Config& cfg, const RunOptions& opt, const std::string& dir, const A& as) {
-  const SignalGuard guard;
+void start_or_resume_in(const Config& cfg, const RunOptions& opt, const std::string& dir, const A& as) {
   if (opt.resume) {
     const std::string ck = dir + "/checkpoint.gsd";
     if (!file_exists(ck)) throw InputError(fmt::format("{}: no checkpoint to resume from", ck));
     auto r = read_checkpoint<typename A::neighbors_type>(ck, cfg);
     auto sim = as.restore(r.box, std::move(r.state), r.neighbors, r.loop);
+    check_restored(sim, as.ops(), ck);
+    const double t_ck = sim.now() - cfg.equilibrate_time;  // measured time reached
+    if (r.driver.phase >= 1 && t_ck > cfg.time)
+      throw InputError(fmt::format("{}: run.time = {} ends before the checkpoint's t = {:.10g}; a resume "
+                                   "may only extend a run", cfg.source, cfg.time, t_ck));
+    if (r.driver.phase >= 1 && cfg.max_collisions &&
+        double(sim.collisions()) - r.driver.coll0 > double(cfg.max_collisions))
+      throw InputError(fmt::format("{}: run.max_collisions = {} is below the {} collisions the checkpoint "
+                                   "has measured; a resume may only extend a run", cfg.source,
+                                   cfg.max_collisions, double(sim.collisions()) - r.driver.coll0));
+    if (run_finished(sim, cfg, r.driver) && file_exists(dir + "/summary.json")) {
+      std::fprintf(stderr,
+                   "hardbody: %s: the run is finished (summary.json, t = %.10g); nothing to do. To "
+                   "extend it: --resume --set run.time=T with T > %.10g\n",
+                   dir.c_str(), t_ck, t_ck);
+      return;
+    }
     const bool grown = cfg.mixture() || (!std::holds_alternative<Sphere>(cfg.one().shape) &&
                                          cfg.init_method == "grow" && cfg.packing_fraction > cfg.init_phi0);
     drive(cfg, opt, dir, sim, r.driver, as.ops(), {{"init", {{"method", grown ? "grow" : "lattice"}}}});
@@ -580,16 +647,33 @@ void start_or_resume(const Config& cfg, const RunOptions& opt, const std::string
       throw InputError(fmt::format("{}: the initial configuration has {} overlapping pairs",
                                    cfg.source, rep.overlaps));
   }
-  make_directories(dir);
   write_file_atomic(dir + "/config.resolved.toml", to_toml(cfg));
   drive(cfg, opt, dir, sim, DriverState{}, as.ops(), {{"init", init_json(start.info)}});
+}
+
+template <class A>
+void start_or_resume(const Config& cfg, const RunOptions& opt, const std::string& dir, const A& as) {
+  const SignalGuard guard;
+  RunDirectory rd(dir, opt.resume, opt.overwrite);  // checked and locked before any work
+  try {
+    start_or_resume_in(cfg, opt, dir, as);
+  } catch (const InputError&) {
+    rd.discard_if_unused();
+    throw;
+  } catch (const ConfigError&) {
+    rd.discard_if_unused();
+    throw;
+  } catch (const std::invalid_argument&) {
+    rd.discard_if_unused();
+    throw;
+  }
 }
 
 }  // namespace
 
 void run_simulation(const RunOptions& opt) {
   const Config cfg = load_config(opt.config_path, opt.overrides);
-  const std::string dir = opt.out_dir.empty() ? default_out_dir(opt.config_path) : opt.out_dir;
+  const std::string dir = opt.out_dir.empty() && !opt.out_given ? default_out_dir(opt.config_path) : opt.out_dir;
   try {
     // Everything is checked (by the builder) before any file is written.
     assemble(cfg, [&](const auto& as) { start_or_resume(cfg, opt, dir, as); });

@@ -10,7 +10,9 @@ struct RunOptions {
   std::string config_path;
   std::string out_dir;  // empty: ./run-<config stem>
   std::vector<std::string> overrides;
+  bool out_given = false;  // --out was given (then an empty out_dir is an error)
   bool resume = false;
+  bool overwrite = false;  // replace a previous run in out_dir (io/run_directory.hpp)
   bool quiet = false;   // no progress line
 };
 

@@ -1,17 +1,20 @@
 // Block averaging of a time series of equal-duration block means, with the standard error
 // from the Flyvbjerg–Petersen blocking transformation: blocks are merged pairwise while at
 // least `min_blocks` remain, and the largest standard error over the levels is reported (the
-// plateau value when blocks outlast the correlation time; conservative otherwise).
+// plateau value when blocks outlast the correlation time; conservative otherwise). With fewer
+// than two blocks the error is unknown: NaN (null in summary.json), never a false 0.
 #pragma once
 #include <cmath>
+#include <limits>
 #include <vector>
 
 namespace hb {
 
 struct MeanError {
   double mean = 0.0;
-  double error = 0.0;
+  double error = std::numeric_limits<double>::quiet_NaN();  // unknown below two blocks
   std::size_t blocks = 0;
+  bool error_known() const { return !std::isnan(error); }
 };
 
 inline MeanError block_average(std::vector<double> x, std::size_t min_blocks = 16) {

@@ -33,3 +33,16 @@ TEST(BlockAverage, CorrelatedSeriesErrorGrows) {
   EXPECT_GT(r.error / naive, 3.5);
   EXPECT_LT(r.error / naive, 5.5);
 }
+
+// Below two blocks the error of the mean is unknown: NaN (null in summary.json), not 0 (a run of
+// one log block once reported "Z +- 0.00000").
+TEST(BlockAverage, ErrorIsUnknownBelowTwoBlocks) {
+  EXPECT_FALSE(block_average({}).error_known());
+  const auto one = block_average({3.0});
+  EXPECT_EQ(one.mean, 3.0);
+  EXPECT_FALSE(one.error_known());
+  EXPECT_TRUE(std::isnan(one.error));
+  const auto two = block_average({3.0, 5.0});
+  EXPECT_TRUE(two.error_known());
+  EXPECT_DOUBLE_EQ(two.error, 1.0);
+}

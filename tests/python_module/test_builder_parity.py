@@ -72,7 +72,7 @@ def test_cli_and_python_give_identical_states(tmp_path, name):
                    np.asarray(f.log["particles/hardbody/position_double"]),
                    np.asarray(f.log["particles/hardbody/orientation_double"]),
                    np.asarray(f.log["particles/hardbody/velocity_double"])) for f in traj]
-    assert [f[0] for f in frames] == [0.0, t]
+    assert [f[0] for f in frames] == [0.0, t, 2 * t]  # the grid, then the final state
     sim = hardbody.Simulation(path)
     for time, pos, quat, vel in frames:
         sim.run(until=time) if time > 0 else None

@@ -94,7 +94,7 @@ def test_trajectory_fields_for_ovito(tmp_path):
     r = run(["run", str(cfg), "--out", "o", "--quiet"], tmp_path)
     assert r.returncode == 0, r.stderr
     with gsd.hoomd.open(str(tmp_path / "o" / "trajectory.gsd"), mode="rb") as t:
-        assert len(t) == 2
+        assert len(t) == 3  # t = 0 and 4 on the snapshot grid, then the final state (t = 8)
         f = t[1]
         L = f.configuration.box[:3]
         assert f.particles.N == 2048
