@@ -100,6 +100,35 @@ CollisionContact collision_contact(const BodyState& a, const BodyState& b, const
   return c;
 }
 
+// The prediction loop of the rigid pair models (RigidBodies, RigidMixture): body i (at `now`)
+// against the candidates js (at their images `shifts`, or the minimum image), each window cut at
+// the candidate's horizon, at law_end (where the growth law changes) and, with `trim`, at the
+// earliest contact found so far (later ones are not needed). solve(a, b, j, horizon) runs the
+// pair's contact-time solver; a failed solve throws SolverFailure(fail(a, b, j, horizon)).
+template <class Solve, class Fail>
+void predict_contacts(const State& s, const Box& box, std::uint32_t i, const std::uint32_t* js,
+                      const Vec3* shifts, std::size_t n, double now, const double* horizons,
+                      double* out, double law_end, bool trim, SolverStats& stats, Solve&& solve,
+                      Fail&& fail) {
+  const BodyState a = s.body(i);  // body i is at `now`
+  double earliest = kInf;
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::uint32_t j = js[k];
+    out[k] = kInf;
+    const double horizon = trim ? std::min({horizons ? horizons[k] : kInf, law_end, earliest}) : law_end;
+    if (j == i || !(horizon > now)) continue;
+    BodyState b = s.body_at(j, now);
+    b.r = shifts ? Vec3(b.r + shifts[k]) : Vec3(a.r + box.near_image(b.r - a.r));
+    const ContactResult r = solve(a, b, j, horizon);
+    stats.add(r);
+    if (r.status == ContactStatus::failed) throw SolverFailure(fail(a, b, j, horizon));
+    if (r.status == ContactStatus::hit) {
+      out[k] = std::max(0.0, r.time - now);
+      earliest = std::min(earliest, r.time);
+    }
+  }
+}
+
 inline double total_kinetic_energy(const State& s, const MassProperties& mass) {
   double k = 0.0;
   for (std::size_t i = 0; i < s.size(); ++i) k += hb::kinetic_energy(s.body(i), mass);
@@ -161,33 +190,22 @@ struct RigidBodies {
   void contact_times(const State& s, const Box& box, std::uint32_t i, const std::uint32_t* js,
                      const Vec3* shifts, std::size_t n, double now, const double* horizons,
                      double* out) const {
-    const BodyState a = s.body(i);  // body i is at `now`
     const ScaleLaw sl{law.scale_at(now), law.rate_at(now)};        // {1, 0} without growth
     const double law_end = now < law.t_stop ? law.t_stop : kInf;  // the law changes there
-    double earliest = kInf;  // earliest contact found so far: later ones are not needed
-    for (std::size_t k = 0; k < n; ++k) {
-      const std::uint32_t j = js[k];
-      out[k] = kInf;
-      const double horizon =
-          trim_horizons ? std::min({horizons ? horizons[k] : kInf, law_end, earliest}) : law_end;
-      if (j == i || !(horizon > now)) continue;
-      BodyState b = s.body_at(j, now);
-      b.r = shifts ? Vec3(b.r + shifts[k]) : Vec3(a.r + box.near_image(b.r - a.r));
-      ContactInput<S, S> in{shape, shape, a, b, now, now, horizon, eps_d};
-      in.growth = sl;
-      const ContactResult r = contact_time(in, options);
-      stats.add(r);
-      if (r.status == ContactStatus::failed)
-        throw SolverFailure(fmt::format(
-            "contact-time solver failed for bodies {} and {} at t = {:.17g}{}; reproducer{}: {}", i,
-            j, now,
-            law.growing() ? fmt::format(" (growth scale {:.17g}, rate {:.17g})", sl.s, sl.rate) : "",
-            law.growing() ? " at scale 1" : "", reproducer(a, b, horizon - now)));
-      if (r.status == ContactStatus::hit) {
-        out[k] = std::max(0.0, r.time - now);
-        earliest = std::min(earliest, r.time);
-      }
-    }
+    predict_contacts(
+        s, box, i, js, shifts, n, now, horizons, out, law_end, trim_horizons, stats,
+        [&](const BodyState& a, const BodyState& b, std::uint32_t, double horizon) {
+          ContactInput<S, S> in{shape, shape, a, b, now, now, horizon, eps_d};
+          in.growth = sl;
+          return contact_time(in, options);
+        },
+        [&](const BodyState& a, const BodyState& b, std::uint32_t j, double horizon) {
+          return fmt::format(
+              "contact-time solver failed for bodies {} and {} at t = {:.17g}{}; reproducer{}: {}",
+              i, j, now,
+              law.growing() ? fmt::format(" (growth scale {:.17g}, rate {:.17g})", sl.s, sl.rate) : "",
+              law.growing() ? " at scale 1" : "", reproducer(a, b, horizon - now));
+        });
   }
 
   CollisionRecord collide(State& s, const Box& box, std::uint32_t i, std::uint32_t j,

@@ -89,40 +89,28 @@ struct RigidMixture {
   void contact_times(const State& s, const Box& box, std::uint32_t i, const std::uint32_t* js,
                      const Vec3* shifts, std::size_t n, double now, const double* horizons,
                      double* out) const {
-    const BodyState a = s.body(i);  // body i is at `now`
     const AnyShape sa = body_shape(s, i);
     const ScaleLaw sl{law.scale_at(now), law.rate_at(now)};
     const double law_end = now < law.t_stop ? law.t_stop : kInf;  // the law changes there
-    double earliest = kInf;
-    for (std::size_t k = 0; k < n; ++k) {
-      const std::uint32_t j = js[k];
-      out[k] = kInf;
-      const double horizon =
-          trim_horizons ? std::min({horizons ? horizons[k] : kInf, law_end, earliest}) : law_end;
-      if (j == i || !(horizon > now)) continue;
-      BodyState b = s.body_at(j, now);
-      b.r = shifts ? Vec3(b.r + shifts[k]) : Vec3(a.r + box.near_image(b.r - a.r));
-      const AnyShape sb = body_shape(s, j);
-      const ContactResult r = std::visit(
-          [&](const auto& A, const auto& B) {
-            using SA = std::decay_t<decltype(A)>;
-            using SB = std::decay_t<decltype(B)>;
-            ContactInput<SA, SB> in{A, B, a, b, now, now, horizon, eps_d};
-            in.growth = sl;
-            return contact_time(in, options);
-          },
-          sa, sb);
-      stats.add(r);
-      if (r.status == ContactStatus::failed)
-        throw SolverFailure(fmt::format(
-            "contact-time solver failed for bodies {} and {} at t = {:.17g} (growth scale "
-            "{:.17g}, rate {:.17g}); reproducer: {}",
-            i, j, now, sl.s, sl.rate, reproducer(sa, a, sb, b, horizon - now)));
-      if (r.status == ContactStatus::hit) {
-        out[k] = std::max(0.0, r.time - now);
-        earliest = std::min(earliest, r.time);
-      }
-    }
+    predict_contacts(
+        s, box, i, js, shifts, n, now, horizons, out, law_end, trim_horizons, stats,
+        [&](const BodyState& a, const BodyState& b, std::uint32_t j, double horizon) {
+          return std::visit(
+              [&](const auto& A, const auto& B) {
+                using SA = std::decay_t<decltype(A)>;
+                using SB = std::decay_t<decltype(B)>;
+                ContactInput<SA, SB> in{A, B, a, b, now, now, horizon, eps_d};
+                in.growth = sl;
+                return contact_time(in, options);
+              },
+              sa, body_shape(s, j));
+        },
+        [&](const BodyState& a, const BodyState& b, std::uint32_t j, double horizon) {
+          return fmt::format(
+              "contact-time solver failed for bodies {} and {} at t = {:.17g} (growth scale "
+              "{:.17g}, rate {:.17g}); reproducer: {}",
+              i, j, now, sl.s, sl.rate, reproducer(sa, a, body_shape(s, j), b, horizon - now));
+        });
   }
 
   CollisionRecord collide(State& s, const Box& box, std::uint32_t i, std::uint32_t j,
