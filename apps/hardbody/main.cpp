@@ -5,6 +5,7 @@
 #include <exception>
 
 #include <string>
+#include <vector>
 #include <unistd.h>
 
 #include "io/config.hpp"
@@ -19,6 +20,11 @@
 int main(int argc, char** argv) {
   CLI::App app{"hardbody: event-driven molecular dynamics of hard rigid bodies"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("hardbody ") + HB_VERSION);
+  app.footer(std::string("Documentation: ") + HB_DOCS_DIR +
+             " (README.md; config.md lists every config key, observables.md every output).\n"
+             "Exit status: 0 done, 2 bad input (nothing written), 3 run-time failure (checkpoint "
+             "written), 128+signal interrupted (continue with --resume).");
 
   hb::RunOptions run;
   auto* cmd_run = app.add_subcommand("run", "run a simulation from a TOML config");
@@ -54,6 +60,13 @@ int main(int argc, char** argv) {
   std::string plot_dir;
   auto* cmd_plot = app.add_subcommand("plot", "write PNG plots of a run directory");
   cmd_plot->add_option("run_dir", plot_dir, "run directory")->required();
+
+  // Campaigns (many runs over a grid of --set values, locally or as Slurm job arrays) are driven
+  // by the Python workflow in python/hardbody_campaign.py; its arguments are passed through.
+  std::vector<std::string> campaign_args;
+  auto* cmd_campaign = app.add_subcommand("campaign", "run or inspect a campaign of many runs (docs/campaigns.md)");
+  cmd_campaign->allow_extras();
+  cmd_campaign->prefix_command();
 
   try {
     app.parse(argc, argv);
@@ -96,6 +109,19 @@ int main(int argc, char** argv) {
       } catch (const std::runtime_error& e) {
         throw hb::InputError(e.what());
       }
+    }
+    if (cmd_campaign->parsed()) {
+      const std::string script = std::string(HB_PYTHON_DIR) + "/hardbody_campaign.py";
+      std::vector<std::string> args{"python3", script};
+      for (const auto& a : cmd_campaign->remaining()) args.push_back(a);
+      std::vector<char*> argv2;
+      for (auto& a : args) argv2.push_back(a.data());
+      argv2.push_back(nullptr);
+      // the campaign runs this very executable
+      setenv("HARDBODY", std::filesystem::canonical("/proc/self/exe").c_str(), 0);
+      execv("/usr/bin/python3", argv2.data());
+      std::perror("hardbody campaign: cannot start /usr/bin/python3");
+      return 3;
     }
     if (cmd_plot->parsed()) {
       // The plots are Python (matplotlib); Debian's interpreter sees python3-matplotlib.

@@ -44,7 +44,7 @@ const std::vector<KeySpec>& key_specs() {
       {"output", "snapshot_interval", Kind::Float, "simulated time between trajectory frames (each checked for overlaps)"},
       {"output", "checkpoint_interval", Kind::Float, "wall seconds between checkpoints (also written on SIGINT/SIGTERM and failures)"},
       {"output", "trajectory", Kind::Bool, "write trajectory.gsd"},
-      {"init", "method", Kind::String, "dense start of non-spherical bodies: \"grow\" (Lubachevsky-Stillinger from init.phi0) or \"lattice\" (stretched lattice at the target); mixtures always grow from a random placement"},
+      {"init", "method", Kind::String, "\"auto\" (default): \"lattice\" for one species of equal spheres, \"grow\" otherwise; \"grow\": Lubachevsky-Stillinger growth from a dilute placement at init.phi0; \"lattice\": (stretched) lattice at the target; mixtures always grow from a random placement"},
       {"init", "phi0", Kind::Float, "packing fraction of the dilute start that is grown"},
       {"init", "growth_rate", Kind::Float, "d(scale)/dt of the growth (scale 1 = target size)"},
       {"observables", "interval", Kind::Float, "sampling interval of MSD, C2, F_self (0: off)"},
@@ -460,8 +460,12 @@ Config validate(const std::string& file, const toml::table& root) {
   if (!(c.log_interval > 0.0)) bad("output", "log_interval", "must be positive");
   if (!(c.snapshot_interval > 0.0)) bad("output", "snapshot_interval", "must be positive");
   if (!(c.checkpoint_interval > 0.0)) bad("output", "checkpoint_interval", "must be positive");
-  if (c.init_method != "grow" && c.init_method != "lattice")
-    bad("init", "method", fmt::format("must be \"grow\" or \"lattice\" (got \"{}\")", c.init_method));
+  if (c.init_method != "auto" && c.init_method != "grow" && c.init_method != "lattice")
+    bad("init", "method", fmt::format("must be \"auto\", \"grow\" or \"lattice\" (got \"{}\")", c.init_method));
+  // "auto": one species of equal spheres starts on the FCC lattice at the target; everything else
+  // grows (config.resolved.toml records the method used)
+  if (c.init_method == "auto")
+    c.init_method = !c.mixture() && std::holds_alternative<Sphere>(c.one().shape) ? "lattice" : "grow";
   if (!(c.init_phi0 > 0.0 && c.init_phi0 < 0.5)) bad("init", "phi0", "must be in (0, 0.5)");
   if (!(c.init_growth_rate > 0.0)) bad("init", "growth_rate", "must be positive");
   if (c.obs_interval < 0.0) bad("observables", "interval", "must not be negative (0 switches it off)");

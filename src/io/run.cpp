@@ -13,6 +13,7 @@
 #include <optional>
 #include <sstream>
 
+#include "core/interrupt.hpp"
 #include "io/checkpoint.hpp"
 #include "io/config.hpp"
 #include "io/files.hpp"
@@ -29,13 +30,12 @@ namespace hb {
 
 namespace {
 
-std::atomic<int> g_signal{0};
-extern "C" void on_signal(int sig) { g_signal.store(sig); }
+extern "C" void on_signal(int sig) { request_stop(sig); }
 
 struct SignalGuard {
   struct sigaction old_int {}, old_term {};
   SignalGuard() {
-    g_signal.store(0);
+    clear_stop();
     struct sigaction sa {};
     sa.sa_handler = on_signal;
     sigemptyset(&sa.sa_mask);
@@ -160,12 +160,6 @@ void check_restored(const Sim& sim, const SystemOps& ops, const std::string& pat
                                  "state: the file is damaged or not this run's", path, rep.overlaps,
                                  rep.min_distance));
 }
-
-class Interrupted : public std::runtime_error {
- public:
-  explicit Interrupted(int sig) : std::runtime_error("interrupted"), signal(sig) {}
-  int signal;
-};
 
 // The run driver, generic over the simulation type (sphere cells / sphere lists / ...).
 template <class Sim>
@@ -352,7 +346,7 @@ class Driver {
   }
 
   void housekeeping() {
-    if (const int sig = g_signal.load()) throw Interrupted(sig);
+    poll_interrupt();
     if (progress_.wall_seconds() - last_checkpoint_ >= cfg_.checkpoint_interval) write_checkpoint();
   }
   // End of the log block that starts at t0: one log interval later, or the end of the run. A

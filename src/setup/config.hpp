@@ -48,7 +48,8 @@ struct Config {
   double checkpoint_interval = 600.0;  // wall seconds
   bool trajectory = true;
   // [init]  dense starts of non-spherical bodies
-  std::string init_method = "grow";  // "grow" (Lubachevsky–Stillinger from init.phi0) | "lattice"
+  std::string init_method = "auto";  // "grow" (Lubachevsky–Stillinger from init.phi0) | "lattice"
+                                     // ("auto" is resolved by load_config)
   double init_phi0 = 0.1;            // packing fraction of the dilute lattice that is grown
   double init_growth_rate = 0.05;    // d(scale)/dt of the growth
   // [observables]
