@@ -4,27 +4,36 @@
 Reads the tables a run writes (tab-separated, ``#`` comment lines, one header row) and writes
 PNG figures next to them:
 
-    log.tsv                      -> Z.png       Z per block and running mean vs time
+    log.tsv (+ summary.json)     -> Z.png       Z per block, running mean with its block error band
     correlations.tsv             -> msd.png     MSD, log-log, with slope-1 and slope-2 guides
-                                    c2.png      C2(t) (and C1(t) when present)
+                                    c2.png      C2(t) (and C1(t) when present); not for spheres
                                     fself.png   F_self(q, t)
     gr.tsv (or structure.tsv)    -> gr.png      g(r)
     gr_partial.tsv (mixtures)    -> gr_partial.png  g_ab(r) of every species pair
-    nematic.tsv                  -> s2.png      S2 vs time
+    nematic.tsv                  -> s2.png      S2 vs time; not for spheres
 
-A missing table is skipped with a note on stderr. A missing RUN_DIR, or a table that cannot be
-read, exits with status 2 and one message naming the directory or the file and line.
-Formats: docs/observables.md.
+Units (README): kT = 1, m = 1, lengths l as in the config, time in sqrt(m l^2 / kT). A sphere run
+(summary.json: every "shape" has type "sphere") draws no c2.png or s2.png (both are 1 for
+spheres) and removes stale ones. Legends sit outside the axes, beside the data.
+
+A missing table is skipped with a note on stderr. A missing RUN_DIR, or a table (or
+summary.json) that cannot be read, exits with status 2 and one message naming the directory or
+the file and line. Formats: docs/observables.md.
 """
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import sys
 from pathlib import Path
 
 EXIT_BAD_INPUT = 2
+
+# Axis labels (README "Units": kT = 1, m = 1, lengths l as in the config).
+TIME_LABEL = "time t  [sqrt(m l^2 / kT)]"
+LENGTH_LABEL = "r  [l]"
 
 
 class TableError(Exception):
@@ -90,6 +99,45 @@ def note(msg: str) -> None:
     print(f"hardbody plot: {msg}", file=sys.stderr)
 
 
+def block_error(values: list[float], min_blocks: int = 16) -> float:
+    """Standard error of the mean of equal-duration block means: the Flyvbjerg-Petersen blocking
+    of src/observers/block_average.hpp (largest error over the pairwise-merged levels while at
+    least ``min_blocks`` remain). NaN with fewer than two blocks (unknown, never a false 0)."""
+    x = [v for v in values if math.isfinite(v)]
+    if len(x) < 2:
+        return math.nan
+    best = 0.0
+    while True:
+        n = len(x)
+        m = sum(x) / n
+        se = math.sqrt(sum((v - m) ** 2 for v in x) / (n * (n - 1)))
+        best = max(best, se)
+        if n // 2 < min_blocks:
+            return best
+        x = [0.5 * (x[2 * k] + x[2 * k + 1]) for k in range(n // 2)]
+
+
+def read_summary(run_dir: Path) -> dict:
+    """summary.json of the run, or {} when there is none (an unfinished run)."""
+    path = run_dir / "summary.json"
+    if not path.is_file():
+        return {}
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, ValueError) as e:
+        raise TableError(f"{path}: cannot read ({e})") from e
+    if not isinstance(data, dict):
+        raise TableError(f"{path}: not a JSON object")
+    return data
+
+
+def is_sphere_run(summary: dict) -> bool:
+    """Every species a sphere (summary.json "shape": one object, or a list for mixtures)."""
+    shape = summary.get("shape")
+    shapes = shape if isinstance(shape, list) else [shape]
+    return bool(shapes) and all(isinstance(s, dict) and s.get("type") == "sphere" for s in shapes)
+
+
 class Plotter:
     def __init__(self, run_dir: Path):
         import matplotlib
@@ -106,13 +154,13 @@ class Plotter:
         final = self.run_dir / name
         tmp = self.run_dir / f".{name}.tmp"
         fig.tight_layout()
-        fig.savefig(tmp, format="png", dpi=110)
+        fig.savefig(tmp, format="png", dpi=110, bbox_inches="tight")
         self.plt.close(fig)
         os.replace(tmp, final)
         self.written.append(final)
 
     def figure(self, xlabel: str, ylabel: str, title: str | None = None):
-        fig, ax = self.plt.subplots(figsize=(6.0, 4.2))
+        fig, ax = self.plt.subplots(figsize=(7.2, 4.2))
         ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
         if title:
@@ -120,18 +168,53 @@ class Plotter:
         ax.grid(True, alpha=0.3)
         return fig, ax
 
-    def log(self, path: Path) -> None:
+    @staticmethod
+    def legend(ax) -> None:
+        """Legend outside the axes, to the right, so that it never covers data."""
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0, fontsize=9)
+
+    def z_figure(self, path: Path, summary: dict | None = None):
+        """Z per block (dots), the running mean (line) with a +-1 block-error band (the error of
+        the mean of the blocks so far, as summary.json computes it at the end), and the final
+        Z +- Z_error of summary.json in the title when present."""
         _, c = read_table(path)
         require(c, path, "time", "Z_block", "Z_mean")
-        fig, ax = self.figure("time", "Z = beta P / rho", "compressibility factor")
+        summary = summary or {}
+        title = "compressibility factor"
+        z, z_err = summary.get("Z"), summary.get("Z_error")
+        if isinstance(z, (int, float)):
+            err = f"{z_err:.2g}" if isinstance(z_err, (int, float)) else "unknown (< 2 blocks)"
+            title += f"   Z = {z:.6g} +- {err} (summary.json)"
+        fig, ax = self.figure(TIME_LABEL, "Z = beta P / rho  [dimensionless]", title)
         x, y = finite_pairs(c["time"], c["Z_block"])
         ax.plot(x, y, ".", ms=3, alpha=0.6, label="Z per block")
-        x, y = finite_pairs(c["time"], c["Z_mean"])
-        ax.plot(x, y, "-", lw=1.5, label="running mean")
-        ax.legend()
+        tm, zm = finite_pairs(c["time"], c["Z_mean"])
+        ax.plot(tm, zm, "-", lw=1.5, label="running mean")
+        # Band: the block error of the first k blocks, at up to 200 k (the last one exact).
+        blocks = c["Z_block"]
+        n = len(blocks)
+        ks = sorted({max(2, round(n * j / 200)) for j in range(1, 201)} | {n}) if n >= 2 else []
+        bt, lo, hi = [], [], []
+        for k in ks:
+            e = block_error(blocks[:k])
+            t, m = c["time"][k - 1], c["Z_mean"][k - 1]
+            if math.isfinite(e) and math.isfinite(t) and math.isfinite(m):
+                bt.append(t)
+                lo.append(m - e)
+                hi.append(m + e)
+        if bt:
+            ax.fill_between(bt, lo, hi, color="C1", alpha=0.3, lw=0, label="running mean +- block error")
+        else:
+            ax.plot([], [], " ", label="block error unknown (< 2 blocks)")
+        self.legend(ax)
+        return fig, ax
+
+    def log(self, path: Path, summary: dict | None = None) -> None:
+        fig, _ = self.z_figure(path, summary)
         self.save(fig, "Z.png")
 
-    def correlations(self, path: Path) -> None:
+    def correlations(self, path: Path, spheres: bool = False) -> None:
         meta, c = read_table(path)
         require(c, path, "time", "msd", "c2", "fself")
         t = c["time"]
@@ -140,7 +223,7 @@ class Plotter:
         if "D" in meta and meta["D"].lower() != "nan":
             title += f"   D = {float(meta['D']):.4g} (fit t in [{float(meta.get('fit_t_from', 'nan')):.3g}, " \
                      f"{float(meta.get('fit_t_to', 'nan')):.3g}])"
-        fig, ax = self.figure("time", "MSD", title)
+        fig, ax = self.figure(TIME_LABEL, "MSD  [l^2]", title)
         x, y = finite_pairs(t, c["msd"], positive=True)
         if x:
             ax.loglog(x, y, "o-", ms=3, label="MSD")
@@ -150,22 +233,23 @@ class Plotter:
                       label="slope 2")
             ax.loglog(x, [y[-1] * (xi / x[-1]) for xi in x], ":", lw=1.2, color="black",
                       label="slope 1")
-            ax.legend()
+            self.legend(ax)
         self.save(fig, "msd.png")
 
-        fig, ax = self.figure("time", "orientational correlation", "C2(t) = <P2(u(0).u(t))>")
-        x, y = finite_pairs(t, c["c2"])
-        ax.plot(x, y, "-", label="C2")
-        if "c1" in c:
-            x, y = finite_pairs(t, c["c1"])
-            ax.plot(x, y, "--", label="C1")
-        ax.axhline(0.0, color="gray", lw=0.8)
-        ax.legend()
-        self.save(fig, "c2.png")
+        if not spheres:  # C2 = C1 = 1 for spheres: nothing to see
+            fig, ax = self.figure(TIME_LABEL, "orientational correlation", "C2(t) = <P2(u(0).u(t))>")
+            x, y = finite_pairs(t, c["c2"])
+            ax.plot(x, y, "-", label="C2")
+            if "c1" in c:
+                x, y = finite_pairs(t, c["c1"])
+                ax.plot(x, y, "--", label="C1")
+            ax.axhline(0.0, color="gray", lw=0.8)
+            self.legend(ax)
+            self.save(fig, "c2.png")
 
         q = meta.get("q")
-        fig, ax = self.figure("time", "F_self(q, t)",
-                              f"self intermediate scattering function, q = {float(q):.4g}"
+        fig, ax = self.figure(TIME_LABEL, "F_self(q, t)",
+                              f"self intermediate scattering function, q = {float(q):.4g} / l"
                               if q and q.lower() != "nan" else "self intermediate scattering function")
         x, y = finite_pairs(t, c["fself"])
         ax.plot(x, y, "-")
@@ -173,11 +257,11 @@ class Plotter:
         self.save(fig, "fself.png")
 
     def simple(self, path: Path, x: str, y: str, name: str, title: str,
-               hline: float | None = None) -> None:
+               hline: float | None = None, xlabel: str | None = None, ylabel: str | None = None) -> None:
         """One column against another, e.g. g(r) or S2(t)."""
         _, c = read_table(path)
         require(c, path, x, y)
-        fig, ax = self.figure(x, y, title)
+        fig, ax = self.figure(xlabel or x, ylabel or y, title)
         xs, ys = finite_pairs(c[x], c[y])
         ax.plot(xs, ys, "-")
         if hline is not None:
@@ -185,7 +269,8 @@ class Plotter:
         self.save(fig, name)
 
     def gr(self, path: Path) -> None:
-        self.simple(path, "r", "g", "gr.png", "radial distribution function g(r)", hline=1.0)
+        self.simple(path, "r", "g", "gr.png", "radial distribution function g(r)", hline=1.0,
+                    xlabel=LENGTH_LABEL, ylabel="g(r)")
 
     def gr_partial(self, path: Path) -> None:
         _, c = read_table(path)
@@ -193,16 +278,17 @@ class Plotter:
         pairs = [k for k in c if k.startswith("g_")]
         if not pairs:
             raise TableError(f"{path}: no g_<a>_<b> column")
-        fig, ax = self.figure("r", "g_ab(r)", "partial radial distribution functions")
+        fig, ax = self.figure(LENGTH_LABEL, "g_ab(r)", "partial radial distribution functions")
         for k in pairs:
             xs, ys = finite_pairs(c["r"], c[k])
             ax.plot(xs, ys, "-", label=k[2:].replace("_", "-", 1))
         ax.axhline(1.0, color="gray", lw=0.8)
-        ax.legend()
+        self.legend(ax)
         self.save(fig, "gr_partial.png")
 
     def nematic(self, path: Path) -> None:
-        self.simple(path, "time", "S2", "s2.png", "nematic order parameter")
+        self.simple(path, "time", "S2", "s2.png", "nematic order parameter", xlabel=TIME_LABEL,
+                    ylabel="S2")
 
 
 def main(argv: list[str]) -> int:
@@ -215,19 +301,34 @@ def main(argv: list[str]) -> int:
         return EXIT_BAD_INPUT
 
     plotter = Plotter(run_dir)
+    try:
+        summary = read_summary(run_dir)
+    except TableError as e:
+        note(str(e))
+        return EXIT_BAD_INPUT
+    spheres = is_sphere_run(summary)
     gr_file = next((run_dir / n for n in ("gr.tsv", "structure.tsv") if (run_dir / n).is_file()), None)
     jobs = [
-        (run_dir / "log.tsv", plotter.log, "Z.png"),
-        (run_dir / "correlations.tsv", plotter.correlations, "msd.png, c2.png, fself.png"),
+        (run_dir / "log.tsv", lambda p: plotter.log(p, summary), "Z.png"),
+        (run_dir / "correlations.tsv", lambda p: plotter.correlations(p, spheres),
+         "msd.png, fself.png" if spheres else "msd.png, c2.png, fself.png"),
         (gr_file or run_dir / "gr.tsv", plotter.gr, "gr.png"),
-        (run_dir / "nematic.tsv", plotter.nematic, "s2.png"),
     ]
+    if spheres:
+        # C2, C1 and S2 are identically 1 for spheres: no c2.png or s2.png (stale ones go).
+        stale = [name for name in ("c2.png", "s2.png") if (run_dir / name).is_file()]
+        for name in stale:
+            (run_dir / name).unlink()
+        note("sphere run: no c2.png or s2.png (orientational order is 1 for spheres)"
+             + (f"; removed stale {', '.join(stale)}" if stale else ""))
+    else:
+        jobs.append((run_dir / "nematic.tsv", plotter.nematic, "s2.png"))
     if (run_dir / "gr_partial.tsv").is_file():  # mixtures only: no note when absent
         jobs.append((run_dir / "gr_partial.tsv", plotter.gr_partial, "gr_partial.png"))
     try:
         for path, plot, outputs in jobs:
             if not path.is_file():
-                what = "gr.tsv or structure.tsv" if plot == plotter.gr else path.name
+                what = "gr.tsv or structure.tsv" if path == (gr_file or run_dir / "gr.tsv") else path.name
                 note(f"no {what} in {run_dir}: skipping {outputs}")
                 continue
             plot(path)

@@ -1,5 +1,6 @@
 """python/hardbody_plot.py on synthetic run directories and on tables the C++ observers wrote."""
 
+import json
 import math
 import os
 import subprocess
@@ -149,3 +150,104 @@ def test_tables_written_by_the_observers(tmp_path):
     assert abs(float(meta["q"]) - 2 * math.pi) < 0.1
     assert cols["time"][0] == 0.0 and cols["msd"][0] == 0.0 and cols["c2"][0] == 1.0
     assert len(cols["time"]) == 41
+
+
+def import_plot_module():
+    sys.path.insert(0, str(SCRIPT.parent))
+    import hardbody_plot
+
+    return hardbody_plot
+
+
+def write_summary(run, shape, z=None, z_error=None):
+    data = {"shape": shape}
+    if z is not None:
+        data["Z"] = z
+        data["Z_error"] = z_error
+    (run / "summary.json").write_text(json.dumps(data))
+
+
+def test_block_error_is_the_blocking_error_of_the_cpp_observer():
+    hp = import_plot_module()
+    # Fewer than 32 blocks: one level, the plain standard error of the mean.
+    x = [1.0, 2.0, 4.0, 7.0]
+    m = sum(x) / 4
+    assert hp.block_error(x) == pytest.approx(math.sqrt(sum((v - m) ** 2 for v in x) / 12))
+    assert math.isnan(hp.block_error([3.0]))  # unknown, not 0
+    # 64 anti-correlated blocks: merging pairs cancels them; the largest level error is kept.
+    alt = [1.0 if k % 2 else -1.0 for k in range(64)]
+    assert hp.block_error(alt) == pytest.approx(math.sqrt(64 / (64 * 63)))
+
+
+def test_z_plot_has_error_band_units_and_a_legend_beside_the_points(tmp_path):
+    hp = import_plot_module()
+    write_log(tmp_path)
+    _, cols = hp.read_table(tmp_path / "log.tsv")
+    err = hp.block_error(cols["Z_block"])
+    plotter = hp.Plotter(tmp_path)
+    fig, ax = plotter.z_figure(tmp_path / "log.tsv", {"Z": cols["Z_mean"][-1], "Z_error": err})
+    # Units of the axes (README: time in sqrt(m l^2 / kT); Z is dimensionless).
+    assert "sqrt(m l^2 / kT)" in ax.get_xlabel()
+    assert "Z" in ax.get_ylabel() and "dimensionless" in ax.get_ylabel()
+    assert "+- " in ax.get_title() and "summary.json" in ax.get_title()
+    # The band: one filled polygon whose half-width at the last time is the block error.
+    bands = [c for c in ax.collections if c.get_label().startswith("running mean +-")]
+    assert len(bands) == 1
+    verts = bands[0].get_paths()[0].vertices
+    t_end = cols["time"][-1]
+    ys = [y for x, y in verts if x == pytest.approx(t_end)]
+    assert max(ys) - min(ys) == pytest.approx(2 * err, rel=1e-9)
+    # The legend lies outside the axes: it covers no data point.
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    legend_box = ax.get_legend().get_window_extent(renderer)
+    axes_box = ax.get_window_extent(renderer)
+    assert legend_box.x0 >= axes_box.x1
+    hp.Plotter(tmp_path).plt.close(fig)
+
+
+def test_z_plot_with_one_block_says_the_error_is_unknown(tmp_path):
+    hp = import_plot_module()
+    write_tsv(tmp_path / "log.tsv", ["time", "collisions", "Z_block", "Z_mean"], [[1.0, 10, 4.2, 4.2]])
+    fig, ax = hp.Plotter(tmp_path).z_figure(tmp_path / "log.tsv", {"Z": 4.2, "Z_error": None})
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert any("unknown" in t for t in labels)
+    assert "unknown" in ax.get_title()
+    assert not [c for c in ax.collections if c.get_label().startswith("running mean +-")]
+
+
+@pytest.mark.parametrize("shape", [{"type": "sphere", "radius": 0.5},
+                                   [{"type": "sphere", "radius": 0.5}, {"type": "sphere", "radius": 0.7}]])
+def test_sphere_runs_draw_no_c2_or_s2(tmp_path, shape):
+    write_log(tmp_path)
+    write_correlations(tmp_path)
+    write_gr(tmp_path)
+    write_nematic(tmp_path)  # an older run wrote it for spheres too
+    write_summary(tmp_path, shape, 4.1, 0.01)
+    (tmp_path / "c2.png").write_bytes(PNG_MAGIC)  # stale, from an earlier plot
+    res = run_plot(tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert_pngs(tmp_path, ["Z.png", "msd.png", "fself.png", "gr.png"])
+    assert not (tmp_path / "c2.png").exists()
+    assert not (tmp_path / "s2.png").exists()
+    assert "sphere run" in res.stderr and "c2.png" in res.stderr
+
+
+def test_mixtures_with_a_non_sphere_draw_c2_and_s2(tmp_path):
+    write_log(tmp_path)
+    write_correlations(tmp_path)
+    write_nematic(tmp_path)
+    write_summary(tmp_path, [{"type": "sphere", "radius": 0.5},
+                             {"type": "ellipsoid", "semi_axes": [1.0, 0.5, 0.5]}])
+    res = run_plot(tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert_pngs(tmp_path, ["c2.png", "s2.png"])
+
+
+def test_unreadable_summary_exits_2_naming_it(tmp_path):
+    write_log(tmp_path)
+    (tmp_path / "summary.json").write_text("{not json")
+    res = run_plot(tmp_path)
+    assert res.returncode == 2
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and "summary.json" in lines[0], res.stderr
