@@ -10,36 +10,56 @@ constexpr const char* P = "particles/hardbody/";
 std::string key(const char* k) { return std::string(P) + k; }
 }  // namespace
 
-gsd::LogArray vec3s(const std::vector<Vec3>& v) {
-  gsd::LogArray a{v.size(), 3, {}};
-  a.values.reserve(3 * v.size());
-  for (const auto& x : v) a.values.insert(a.values.end(), {x.x(), x.y(), x.z()});
-  return a;
+static_assert(sizeof(Vec3) == 3 * sizeof(double) && sizeof(Eigen::Vector3i) == 3 * sizeof(int) &&
+                  sizeof(std::array<int, 3>) == 3 * sizeof(std::int32_t),
+              "vectors of these types are written as N x 3 arrays in place");
+
+// Views of per-body arrays (no copy).
+gsd::ChunkSource view(const std::vector<Vec3>& v) {
+  return gsd::ChunkSource{gsd::Type::float64, v.size(), 3, v.empty() ? nullptr : v.data(), {}, {}};
 }
-gsd::LogArray quats(const std::vector<Quat>& q) {
-  gsd::LogArray a{q.size(), 4, {}};
-  a.values.reserve(4 * q.size());
-  for (const auto& x : q) a.values.insert(a.values.end(), {x.w(), x.x(), x.y(), x.z()});
-  return a;
+gsd::ChunkSource view(const std::vector<double>& v) { return gsd::memory_source(v, 1); }
+gsd::ChunkSource quat_rows(const std::vector<Quat>& q) {
+  return gsd::row_source<double>(q.size(), 4, [&q](std::uint64_t i, double* o) {
+    o[0] = q[i].w(), o[1] = q[i].x(), o[2] = q[i].y(), o[3] = q[i].z();
+  });
 }
-gsd::LogArray scalars(const std::vector<double>& v) { return gsd::LogArray{v.size(), 1, v}; }
-gsd::LogArray row(const std::vector<double>& v) {
-  return gsd::LogArray{1, static_cast<std::uint32_t>(std::max<std::size_t>(v.size(), 1)),
-                       v.empty() ? std::vector<double>{0.0} : v};
+// A record of the driver: 1 x n doubles (a GSD chunk needs a value: empty is stored as {0}).
+gsd::ChunkSource record(const std::vector<double>& v) {
+  gsd::LogArray a{1, static_cast<std::uint32_t>(std::max<std::size_t>(v.size(), 1)),
+                  v.empty() ? std::vector<double>{0.0} : v};
+  return gsd::owned_source(std::move(a));
 }
-gsd::LogArray events(const std::vector<Event>& e) {
-  gsd::LogArray a{e.size(), 4, {}};
-  a.values.reserve(4 * e.size());
-  for (const auto& x : e)
-    a.values.insert(a.values.end(), {x.time, double(x.partner), double(x.partner_count), double(int(x.type))});
-  return a;
+// Events of the calendar: time, partner, partner count, type (all as doubles, exact).
+gsd::ChunkSource event_rows(std::shared_ptr<const LoopSnapshot> loop,
+                            const std::vector<Event> LoopSnapshot::*which) {
+  const std::vector<Event>& e = (*loop).*which;
+  return gsd::row_source<double>(e.size(), 4, [&e, loop](std::uint64_t i, double* o) {
+    o[0] = e[i].time, o[1] = double(e[i].partner), o[2] = double(e[i].partner_count);
+    o[3] = double(int(e[i].type));
+  });
 }
-gsd::LogArray encode(const std::vector<std::array<int, 3>>& c) {
-  gsd::LogArray a{c.size(), 3, {}};
-  for (const auto& x : c) a.values.insert(a.values.end(), {double(x[0]), double(x[1]), double(x[2])});
-  return a;
+
+// Body i at `now`: what State::advance_to and Box::wrap make of it in synchronized_state.
+struct Synced {
+  Vec3 r;
+  Quat q;
+  Vec3 w;
+  Eigen::Vector3i image;
+};
+Synced synced(const State& s, std::size_t i, double now, const Box& box, bool rotation) {
+  Synced b{s.r[i], s.q[i], s.w[i], s.image[i]};
+  const double dt = now - s.t[i];
+  if (dt != 0.0) {
+    b.r += s.v[i] * dt;
+    if (rotation && b.w.squaredNorm() != 0.0) {
+      if (spherical_top(s.top(i))) b.q = orientation_at(BodyState{b.r, b.q, s.v[i], b.w}, dt);
+      else s.free_rotation(i).evaluate(dt, b.q, b.w);
+    }
+  }
+  b.image += box.wrap(b.r);
+  return b;
 }
-gsd::LogArray encode(const std::vector<Vec3>& c) { return vec3s(c); }
 
 // The keys a checkpoint must agree on with the config that resumes it; the shape's part is its
 // type (registry index) and the parameters of its codec entry.
@@ -92,84 +112,117 @@ ConfigSignature config_signature(const Config& c) {
   return std::move(w.sig);
 }
 
-void fill_frame(gsd::HoomdFrame& f, const State& s, const Box& box, double now, std::uint64_t step,
-                const SpeciesTable& species) {
+gsd::FrameSource frame_source(const State& s, const Box& box, double now, std::uint64_t step,
+                              const SpeciesTable& species) {
+  using gsd::row_source;
   const std::size_t n = s.size();
+  const State* S = &s;
+  gsd::FrameSource f;
   f.step = step;
   f.N = static_cast<std::uint32_t>(n);
   f.box = {float(box.L.x()), float(box.L.y()), float(box.L.z()), 0, 0, 0};
-  f.position.resize(3 * n);
-  f.orientation.resize(4 * n);
-  f.velocity.resize(3 * n);
-  f.image.resize(3 * n);
-  f.type_id.resize(n);
-  f.diameter.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    for (int k = 0; k < 3; ++k) {
-      // HOOMD boxes are centred on the origin; the engine's box is [0, L).
-      f.position[3 * i + k] = float(s.r[i][k] - 0.5 * box.L[k]);
-      f.velocity[3 * i + k] = float(s.v[i][k]);
-      f.image[3 * i + k] = s.image[i][k];
-    }
-    f.orientation[4 * i] = float(s.q[i].w());
-    f.orientation[4 * i + 1] = float(s.q[i].x());
-    f.orientation[4 * i + 2] = float(s.q[i].y());
-    f.orientation[4 * i + 3] = float(s.q[i].z());
-    f.type_id[i] = s.species[i];
-    f.diameter[i] = float(2.0 * bounding_radius(species[s.species[i]].shape) * s.scale[i]);
-  }
-  f.types.clear();
-  f.type_shapes.clear();
+  // HOOMD boxes are centred on the origin; the engine's box is [0, L).
+  f.position = row_source<float>(n, 3, [S, box, now](std::uint64_t i, float* o) {
+    const Vec3 r = synced(*S, i, now, box, false).r;
+    for (int k = 0; k < 3; ++k) o[k] = float(r[k] - 0.5 * box.L[k]);
+  });
+  f.orientation = row_source<float>(n, 4, [S, box, now](std::uint64_t i, float* o) {
+    const Quat q = synced(*S, i, now, box, true).q;
+    o[0] = float(q.w()), o[1] = float(q.x()), o[2] = float(q.y()), o[3] = float(q.z());
+  });
+  f.velocity = row_source<float>(n, 3, [S](std::uint64_t i, float* o) {
+    for (int k = 0; k < 3; ++k) o[k] = float(S->v[i][k]);
+  });
+  f.image = row_source<std::int32_t>(n, 3, [S, box, now](std::uint64_t i, std::int32_t* o) {
+    const Eigen::Vector3i m = synced(*S, i, now, box, false).image;
+    for (int k = 0; k < 3; ++k) o[k] = m[k];
+  });
+  f.type_id = row_source<std::uint32_t>(n, 1, [S](std::uint64_t i, std::uint32_t* o) {
+    *o = S->species[i];
+  });
+  std::vector<double> bounding;
   for (const Species& sp : species) {
     f.types.push_back(sp.name);
     f.type_shapes.push_back(gsd_type_shape(sp.shape));
+    bounding.push_back(bounding_radius(sp.shape));
   }
+  f.diameter = row_source<float>(n, 1, [S, bounding](std::uint64_t i, float* o) {
+    *o = float(2.0 * bounding[S->species[i]] * S->scale[i]);
+  });
   // Exact state in the engine's frame [0, L) (box_origin 0), for analysis and conversion.
-  f.log[key("position_double")] = vec3s(s.r);
-  f.log[key("orientation_double")] = quats(s.q);
-  f.log[key("velocity_double")] = vec3s(s.v);
-  f.log[key("angular_velocity_double")] = vec3s(s.w);
-  f.log[key("scale")] = scalars(s.scale);
-  f.log["hardbody/time"] = row({now});
-  f.log["hardbody/box_origin"] = row({0.0, 0.0, 0.0});
-  f.log["hardbody/box_double"] = row({box.L.x(), box.L.y(), box.L.z(), 0.0, 0.0, 0.0});
+  f.log[key("position_double")] = row_source<double>(n, 3, [S, box, now](std::uint64_t i, double* o) {
+    const Vec3 r = synced(*S, i, now, box, false).r;
+    o[0] = r.x(), o[1] = r.y(), o[2] = r.z();
+  });
+  f.log[key("orientation_double")] = row_source<double>(n, 4, [S, box, now](std::uint64_t i, double* o) {
+    const Quat q = synced(*S, i, now, box, true).q;
+    o[0] = q.w(), o[1] = q.x(), o[2] = q.y(), o[3] = q.z();
+  });
+  f.log[key("velocity_double")] = view(s.v);
+  f.log[key("angular_velocity_double")] = row_source<double>(n, 3, [S, box, now](std::uint64_t i, double* o) {
+    const Vec3 w = synced(*S, i, now, box, true).w;
+    o[0] = w.x(), o[1] = w.y(), o[2] = w.z();
+  });
+  f.log[key("scale")] = view(s.scale);
+  f.log["hardbody/time"] = record({now});
+  f.log["hardbody/box_origin"] = record({0.0, 0.0, 0.0});
+  f.log["hardbody/box_double"] = record({box.L.x(), box.L.y(), box.L.z(), 0.0, 0.0, 0.0});
+  return f;
 }
 
-void add_checkpoint_logs(gsd::HoomdFrame& f, const State& s, const LoopSnapshot& loop,
-                         const DriverState& d, const Config& c) {
-  f.log[key("state_r")] = vec3s(s.r);
-  f.log[key("state_v")] = vec3s(s.v);
-  f.log[key("state_q")] = quats(s.q);
-  f.log[key("state_w")] = vec3s(s.w);
-  f.log[key("state_t")] = scalars(s.t);
-  std::vector<double> cnt(s.size());
-  std::vector<Vec3> img(s.size());
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    cnt[i] = double(s.count[i]);
-    img[i] = s.image[i].cast<double>();
-  }
-  f.log[key("state_count")] = scalars(cnt);
-  f.log[key("state_image")] = vec3s(img);
-  f.log[key("calendar")] = events(loop.slot);
-  f.log[key("best")] = events(loop.best);
-  std::vector<double> l{loop.now, double(loop.stale)};
-  for (auto x : loop.counts) l.push_back(double(x));
-  f.log["hardbody/loop"] = row(l);
+void add_checkpoint_sources(gsd::FrameSource& f, const State& s, LoopSnapshot loop_snapshot,
+                            const DriverState& d, const Config& c) {
+  const auto loop = std::make_shared<const LoopSnapshot>(std::move(loop_snapshot));
+  f.log[key("state_r")] = view(s.r);
+  f.log[key("state_v")] = view(s.v);
+  f.log[key("state_q")] = quat_rows(s.q);
+  f.log[key("state_w")] = view(s.w);
+  f.log[key("state_t")] = view(s.t);
+  // Integers as such (readers convert every numeric log chunk to double exactly).
+  f.log[key("state_count")] = gsd::memory_source(s.count, 1);
+  f.log[key("state_image")] = gsd::ChunkSource{gsd::Type::int32, s.image.size(), 3,
+                                               s.image.empty() ? nullptr : s.image.data(), {}, {}};
+  f.log[key("calendar")] = event_rows(loop, &LoopSnapshot::slot);
+  f.log[key("best")] = event_rows(loop, &LoopSnapshot::best);
+  std::vector<double> l{loop->now, double(loop->stale)};
+  for (auto x : loop->counts) l.push_back(double(x));
+  f.log["hardbody/loop"] = record(l);
   std::vector<double> dr{double(d.phase), d.e0, d.coll0, d.stale0, double(d.log_rows),
                          double(d.frames), d.next_snapshot, d.block_start, d.cpu_prev, d.wall_prev,
                          d.next_corr, d.next_gr};
   dr.insert(dr.end(), d.events0.begin(), d.events0.end());
-  f.log["hardbody/driver"] = row(dr);
-  f.log["hardbody/pressure"] = row(d.pressure);
-  f.log["hardbody/obs_correlations"] = row(d.corr);
-  f.log["hardbody/obs_gr"] = row(d.gr);
-  f.log["hardbody/obs_nematic"] = row(d.nematic);
-  f.log["hardbody/pair_collisions"] = row(d.pair_collisions);
-  f.log["hardbody/obs_gr_partial"] = row(d.gr_partial);
-  f.log["hardbody/obs_temperatures"] = row(d.temperatures);
+  f.log["hardbody/driver"] = record(dr);
+  f.log["hardbody/pressure"] = record(d.pressure);
+  f.log["hardbody/obs_correlations"] = record(d.corr);
+  f.log["hardbody/obs_gr"] = record(d.gr);
+  f.log["hardbody/obs_nematic"] = record(d.nematic);
+  f.log["hardbody/pair_collisions"] = record(d.pair_collisions);
+  f.log["hardbody/obs_gr_partial"] = record(d.gr_partial);
+  f.log["hardbody/obs_temperatures"] = record(d.temperatures);
   for (std::size_t a = 0; a < d.corr_species.size(); ++a)
-    f.log[fmt::format("hardbody/obs_correlations_species{}", a)] = row(d.corr_species[a]);
-  f.log["hardbody/config"] = row(config_signature(c).values);
+    f.log[fmt::format("hardbody/obs_correlations_species{}", a)] = record(d.corr_species[a]);
+  f.log["hardbody/config"] = record(config_signature(c).values);
+}
+
+gsd::ChunkSource encode(std::vector<std::array<int, 3>> c) {
+  auto keep = std::make_shared<const std::vector<std::array<int, 3>>>(std::move(c));
+  return gsd::ChunkSource{gsd::Type::int32, keep->size(), 3, keep->empty() ? nullptr : keep->data(),
+                          {}, keep};
+}
+gsd::ChunkSource encode(std::vector<Vec3> c) {
+  auto keep = std::make_shared<const std::vector<Vec3>>(std::move(c));
+  gsd::ChunkSource s = view(*keep);
+  s.owner = std::move(keep);
+  return s;
+}
+gsd::ChunkSource encode(ObbSnapshot c) {
+  const auto sn = std::make_shared<const ObbSnapshot>(std::move(c));
+  return gsd::row_source<double>(sn->centre.size(), 10, [sn](std::uint64_t i, double* o) {
+    const Vec3 &x = sn->centre[i], &h = sn->half[i];
+    const Quat& q = sn->q[i];
+    const double v[10] = {x.x(), x.y(), x.z(), q.w(), q.x(), q.y(), q.z(), h.x(), h.y(), h.z()};
+    std::copy(v, v + 10, o);
+  });
 }
 
 const gsd::LogArray& Reader::get(const std::string& k, std::uint64_t rows, std::uint32_t cols) const {
@@ -300,15 +353,6 @@ void decode(const Reader& r, std::vector<std::array<int, 3>>& out) {
 }
 void decode(const Reader& r, std::vector<Vec3>& out) { out = r.vec3s(key("neighbors"), r.f.N); }
 
-gsd::LogArray encode(const ObbSnapshot& c) {
-  gsd::LogArray a{c.centre.size(), 10, {}};
-  a.values.reserve(10 * c.centre.size());
-  for (std::size_t i = 0; i < c.centre.size(); ++i)
-    a.values.insert(a.values.end(), {c.centre[i].x(), c.centre[i].y(), c.centre[i].z(), c.q[i].w(),
-                                     c.q[i].x(), c.q[i].y(), c.q[i].z(), c.half[i].x(),
-                                     c.half[i].y(), c.half[i].z()});
-  return a;
-}
 void decode(const Reader& r, ObbSnapshot& out) {
   const std::uint64_t n = r.f.N;
   const auto& a = r.get(key("neighbors"), n, 10);

@@ -5,6 +5,7 @@
 #pragma once
 #include <array>
 #include <fmt/format.h>
+#include <memory>
 
 #include <cstdint>
 #include <string>
@@ -49,21 +50,24 @@ State synchronized_state(const Sim& sim) {
 }
 
 namespace ckpt {
-gsd::LogArray vec3s(const std::vector<Vec3>& v);
-gsd::LogArray quats(const std::vector<Quat>& q);
-gsd::LogArray scalars(const std::vector<double>& v);
-gsd::LogArray row(const std::vector<double>& v);
-gsd::LogArray events(const std::vector<Event>& e);
-gsd::LogArray cells(const std::vector<std::array<int, 3>>& c);
 struct ConfigSignature {
   std::vector<std::string> names;
   std::vector<double> values;
 };
 ConfigSignature config_signature(const Config& c);
-void fill_frame(gsd::HoomdFrame& f, const State& synced, const Box& box, double now,
-                std::uint64_t step, const SpeciesTable& species);
-void add_checkpoint_logs(gsd::HoomdFrame& f, const State& s, const LoopSnapshot& loop,
-                         const DriverState& d, const Config& c);
+
+// The frame of the bodies at `now` (each streamed to `now` and wrapped into the box exactly as
+// synchronized_state does), with the exact doubles in log chunks. Its chunks are made a buffer
+// at a time while they are written: nothing of size N is copied. `s` must outlive the frame.
+gsd::FrameSource frame_source(const State& s, const Box& box, double now, std::uint64_t step,
+                              const SpeciesTable& species);
+// Adds what a resume needs: the state at the bodies' own time stamps (views of `s`), the event
+// calendar, the driver's accumulators and the config signature.
+void add_checkpoint_sources(gsd::FrameSource& f, const State& s, LoopSnapshot loop,
+                            const DriverState& d, const Config& c);
+gsd::ChunkSource encode(std::vector<std::array<int, 3>> c);
+gsd::ChunkSource encode(std::vector<Vec3> c);
+gsd::ChunkSource encode(ObbSnapshot c);
 
 // Reading back (throw InputError naming the file and the problem).
 struct Reader {
@@ -79,25 +83,21 @@ Reader open(const std::string& path, const Config& c);
 void read_core(const Reader& r, Box& box, State& s, LoopSnapshot& loop, DriverState& d);
 void decode(const Reader& r, std::vector<std::array<int, 3>>& out);
 void decode(const Reader& r, std::vector<Vec3>& out);
-gsd::LogArray encode(const std::vector<std::array<int, 3>>& c);
-gsd::LogArray encode(const std::vector<Vec3>& c);
 void decode(const Reader& r, ObbSnapshot& out);
-gsd::LogArray encode(const ObbSnapshot& c);
 }  // namespace ckpt
 
-// One trajectory frame (synchronised positions) at the simulation's current time.
+// One trajectory frame (synchronised positions) at the simulation's current time, streamed from
+// the simulation's state (which must not change until the frame is written).
 template <class Sim>
-gsd::HoomdFrame make_frame(const Sim& sim, const SpeciesTable& species, bool, const void*) {
-  gsd::HoomdFrame f;
-  ckpt::fill_frame(f, synchronized_state(sim), sim.box(), sim.now(), sim.collisions(), species);
-  return f;
+gsd::FrameSource make_frame(const Sim& sim, const SpeciesTable& species, bool, const void*) {
+  return ckpt::frame_source(sim.state(), sim.box(), sim.now(), sim.collisions(), species);
 }
 
 template <class Sim>
-gsd::HoomdFrame make_checkpoint(const Sim& sim, const SpeciesTable& species, const Config& c,
-                                const DriverState& d) {
-  gsd::HoomdFrame f = make_frame(sim, species, true, nullptr);
-  ckpt::add_checkpoint_logs(f, sim.state(), sim.snapshot(), d, c);
+gsd::FrameSource make_checkpoint(const Sim& sim, const SpeciesTable& species, const Config& c,
+                                 const DriverState& d) {
+  gsd::FrameSource f = make_frame(sim, species, true, nullptr);
+  ckpt::add_checkpoint_sources(f, sim.state(), sim.snapshot(), d, c);
   f.log["particles/hardbody/neighbors"] = ckpt::encode(sim.neighbors().snapshot());
   return f;
 }

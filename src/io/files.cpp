@@ -1,5 +1,8 @@
 #include "io/files.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <fmt/format.h>
 
 #include <cerrno>
@@ -7,27 +10,94 @@
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
-#include <unistd.h>
+#include <utility>
 
 namespace hb {
 
+namespace {
+
+[[noreturn]] void fail(const std::string& path, std::string_view what, int err) {
+  throw std::runtime_error(fmt::format("{}: {}: {}", path, what, std::strerror(err)));
+}
+
+// fsync of the directory that holds `path`, so that a rename into it survives a crash.
+void sync_parent(const std::string& path) {
+  const auto p = std::filesystem::path(path);
+  const auto dir = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;  // the rename is done; durability of the directory entry is best effort
+  (void)::fsync(fd);
+  ::close(fd);
+}
+
+}  // namespace
+
+void write_all(int fd, const void* data, std::size_t n, const std::string& path,
+               std::string_view what) {
+  const auto* p = static_cast<const char*>(data);
+  while (n > 0) {
+    const ssize_t r = ::write(fd, p, n);
+    if (r < 0 && errno == EINTR) continue;
+    if (r < 0) fail(path, what, errno);
+    if (r == 0) fail(path, what, ENOSPC);  // no progress: only a full device does that
+    p += r;
+    n -= static_cast<std::size_t>(r);
+  }
+}
+
 void write_file_atomic(const std::string& path, const std::string& content) {
   const std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) throw std::runtime_error(fmt::format("{}: cannot write: {}", tmp, std::strerror(errno)));
-  const bool ok = std::fwrite(content.data(), 1, content.size(), f) == content.size() &&
-                  std::fflush(f) == 0 && fsync(fileno(f)) == 0;
-  const int err = errno;
-  std::fclose(f);
-  if (!ok) {
+  try {
+    AppendFile f(tmp, true);
+    f.write(content);
+    f.sync();
+    f.close();
+  } catch (...) {
     std::remove(tmp.c_str());
-    throw std::runtime_error(fmt::format("{}: write failed: {}", tmp, std::strerror(err)));
+    throw;
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     const int e = errno;
     std::remove(tmp.c_str());
-    throw std::runtime_error(fmt::format("{}: cannot rename into place: {}", path, std::strerror(e)));
+    fail(path, "cannot rename " + tmp + " into place", e);
   }
+  sync_parent(path);
+}
+
+AppendFile::AppendFile(std::string path, bool truncate) : path_(std::move(path)) {
+  fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC | (truncate ? O_TRUNC : 0),
+               0644);
+  if (fd_ < 0) fail(path_, "cannot open for writing", errno);
+}
+
+AppendFile::~AppendFile() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+AppendFile::AppendFile(AppendFile&& o) noexcept
+    : path_(std::move(o.path_)), fd_(std::exchange(o.fd_, -1)) {}
+
+AppendFile& AppendFile::operator=(AppendFile&& o) noexcept {
+  if (this != &o) {
+    if (fd_ >= 0) ::close(fd_);
+    path_ = std::move(o.path_);
+    fd_ = std::exchange(o.fd_, -1);
+  }
+  return *this;
+}
+
+void AppendFile::write(std::string_view text) {
+  if (fd_ < 0) throw std::logic_error(fmt::format("{}: write after close", path_));
+  write_all(fd_, text.data(), text.size(), path_);
+}
+
+void AppendFile::sync() {
+  if (fd_ >= 0 && ::fsync(fd_) != 0) fail(path_, "cannot sync to disk", errno);
+}
+
+void AppendFile::close() {
+  if (fd_ < 0) return;
+  if (::close(std::exchange(fd_, -1)) != 0) fail(path_, "cannot close", errno);
 }
 
 void make_directories(const std::string& path) {

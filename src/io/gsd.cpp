@@ -27,7 +27,6 @@ constexpr std::size_t kNameSegment = 64;          // namelist sizes are counted 
 constexpr std::size_t kNameField = 64;            // application / schema fields
 constexpr std::uint64_t kInitialIndexEntries = 128;
 constexpr std::uint64_t kInitialNameSegments = 16;
-constexpr std::size_t kBufferLimit = 8u << 20;    // chunk data gathered before one write
 constexpr std::size_t kMaxNames = 65535;          // name ids are 16-bit
 
 // Header field offsets.
@@ -401,8 +400,34 @@ void Writer::flush_buffer() {
   buffer_.clear();
 }
 
-void Writer::write_chunk(std::string_view name, Type type, std::uint64_t N, std::uint32_t M,
-                         const void* data) {
+void Writer::reserve_buffer(std::size_t row) {
+  const std::size_t want = std::max(buffer_limit_, row);
+  if (buffer_.capacity() < want) buffer_.reserve(want);  // the only buffer; it never grows past this
+}
+
+// After a failed chunk the frame is lost (its data is never indexed); earlier frames stay intact.
+void Writer::drop_frame() {
+  buffer_.clear();
+  pending_.clear();
+}
+
+void Writer::set_buffer_size(std::size_t bytes) {
+  flush_buffer();
+  buffer_limit_ = std::max<std::size_t>(bytes, 1);
+  std::vector<std::byte>().swap(buffer_);  // give back a larger buffer
+}
+
+void Writer::read_back(std::uint64_t location, std::size_t n, void* out) {
+  check_open();
+  flush_buffer();
+  if (!pread_all(fd_.get(), out, n, location))
+    throw std::runtime_error(fmt::format("{}: cannot read back {} bytes at offset {}: {}",
+                                         path_.string(), n, location, errno_text()));
+}
+
+// Validates a chunk, gives its name an id and its data a place at the end of the file.
+std::uint64_t Writer::begin_chunk(std::string_view name, Type type, std::uint64_t N,
+                                  std::uint32_t M, bool has_data, std::uint64_t& bytes) {
   check_open();
   const auto bad = [&](std::string_view why) {
     return std::invalid_argument(fmt::format("{}: cannot write chunk '{}': {}", path_.string(),
@@ -413,9 +438,8 @@ void Writer::write_chunk(std::string_view name, Type type, std::uint64_t N, std:
   if (M == 0) throw bad("M must be at least 1");
   if (type == Type::character) throw bad("the character type needs file layer 2.1");
   if (type_size(type) == 0) throw bad("unknown type");
-  std::uint64_t bytes = 0;
   if (!mul_add(N, std::uint64_t{M} * type_size(type), 0, bytes)) throw bad("size overflows");
-  if (N > 0 && data == nullptr) throw bad("no data");
+  if (N > 0 && !has_data) throw bad("no data");
 
   std::uint16_t id = 0;
   if (auto it = ids_.find(name); it != ids_.end()) {
@@ -428,18 +452,61 @@ void Writer::write_chunk(std::string_view name, Type type, std::uint64_t N, std:
     names_.emplace_back(name);
     ids_.emplace(names_.back(), id);
   }
-
   if (buffer_.empty()) buffer_location_ = file_end_;
   const std::uint64_t location = allocate(bytes);
-  if (bytes >= kBufferLimit) {
-    flush_buffer();
-    pwrite_all(data, bytes, location, fmt::format("chunk '{}'", name));
-  } else {
-    const auto* p = static_cast<const std::byte*>(data);
-    buffer_.insert(buffer_.end(), p, p + bytes);
-    if (buffer_.size() >= kBufferLimit) flush_buffer();
-  }
   pending_.push_back(Chunk{frame_, N, location, M, id, type});
+  return location;
+}
+
+std::uint64_t Writer::write_chunk(std::string_view name, Type type, std::uint64_t N,
+                                  std::uint32_t M, const void* data) {
+  std::uint64_t bytes = 0;
+  const std::uint64_t location = begin_chunk(name, type, N, M, data != nullptr, bytes);
+  try {
+    if (bytes >= buffer_limit_) {  // straight from the caller's memory
+      flush_buffer();
+      pwrite_all(data, bytes, location, fmt::format("chunk '{}'", name));
+    } else if (bytes > 0) {
+      if (buffer_.size() + bytes > buffer_limit_) flush_buffer();
+      reserve_buffer(0);
+      if (buffer_.empty()) buffer_location_ = location;
+      const auto* p = static_cast<const std::byte*>(data);
+      buffer_.insert(buffer_.end(), p, p + bytes);
+      if (buffer_.size() >= buffer_limit_) flush_buffer();
+    }
+  } catch (...) {
+    drop_frame();
+    throw;
+  }
+  return location;
+}
+
+std::uint64_t Writer::write_chunk(std::string_view name, Type type, std::uint64_t N,
+                                  std::uint32_t M, const RowFill& fill) {
+  std::uint64_t bytes = 0;
+  const std::uint64_t location = begin_chunk(name, type, N, M, bool(fill), bytes);
+  const std::size_t row = std::size_t{M} * type_size(type);
+  try {
+    reserve_buffer(row);
+    for (std::uint64_t first = 0; first < N;) {
+      std::size_t room = buffer_limit_ > buffer_.size() ? buffer_limit_ - buffer_.size() : 0;
+      if (room < row && !buffer_.empty()) {
+        flush_buffer();
+        room = buffer_limit_;
+      }
+      if (buffer_.empty()) buffer_location_ = location + first * row;
+      const std::uint64_t count = std::min<std::uint64_t>(N - first, std::max<std::size_t>(room / row, 1));
+      const std::size_t at = buffer_.size();
+      buffer_.resize(at + count * row);
+      fill(first, count, buffer_.data() + at);
+      first += count;
+      if (buffer_.size() >= buffer_limit_) flush_buffer();
+    }
+  } catch (...) {
+    drop_frame();
+    throw;
+  }
+  return location;
 }
 
 void Writer::end_frame() {

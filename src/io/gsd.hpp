@@ -196,8 +196,14 @@ class Reader {
   std::uint64_t nframes_ = 0;
 };
 
+// Fills rows [first, first + count) of an N x M chunk: count * M * type_size bytes at `out`.
+using RowFill = std::function<void(std::uint64_t first, std::uint64_t count, std::byte* out)>;
+
 // Writes frames to a new file or appends to an existing one. Move-only. Destroying a writer with
 // an unfinished frame drops that frame (its data stays in the file, unindexed and harmless).
+//
+// Memory: chunk data goes to the file through one buffer of buffer_size() bytes (8 MiB by
+// default; larger only for a single row that does not fit), never a copy of the whole frame.
 class Writer {
  public:
   // Create (or truncate) `path`. The schema version is the caller's (HOOMD schema: 1.4).
@@ -210,12 +216,17 @@ class Writer {
   // Add an N x M chunk (row-major, N*M*type_size(type) bytes at data) to the current frame.
   // Throws std::invalid_argument for M == 0, an empty or repeated name, more than 65535 names,
   // or the character type; std::runtime_error on I/O failure.
-  void write_chunk(std::string_view name, Type type, std::uint64_t N, std::uint32_t M,
-                   const void* data);
+  // Returns the file offset of the chunk's data.
+  std::uint64_t write_chunk(std::string_view name, Type type, std::uint64_t N, std::uint32_t M,
+                            const void* data);
+  // The same, with the rows produced on demand by `fill`, a buffer's worth at a time. An I/O
+  // failure (or an exception from fill) drops the whole current frame.
+  std::uint64_t write_chunk(std::string_view name, Type type, std::uint64_t N, std::uint32_t M,
+                            const RowFill& fill);
   template <class T>
   void write_chunk(std::string_view name, std::uint64_t N, std::uint32_t M, std::span<const T> data) {
     check_count(name, N, M, data.size());
-    write_chunk(name, type_of<T>(), N, M, data.data());
+    write_chunk(name, type_of<T>(), N, M, static_cast<const void*>(data.data()));
   }
   template <class T>
   void write_chunk(std::string_view name, std::uint64_t N, std::uint32_t M, const std::vector<T>& data) {
@@ -232,8 +243,18 @@ class Writer {
   const std::filesystem::path& path() const { return path_; }
   std::uint64_t frame() const { return frame_; }  // index of the frame being written
 
+  // Bytes of chunk data gathered before one write (at least 1). Tests use tiny buffers.
+  void set_buffer_size(std::size_t bytes);
+  std::size_t buffer_size() const { return buffer_limit_; }
+  // Read n bytes of chunk data written earlier (at a location write_chunk returned).
+  void read_back(std::uint64_t location, std::size_t n, void* out);
+
  private:
   Writer() = default;
+  std::uint64_t begin_chunk(std::string_view name, Type type, std::uint64_t N, std::uint32_t M,
+                            bool has_data, std::uint64_t& bytes);
+  void reserve_buffer(std::size_t row);
+  void drop_frame();
   void check_count(std::string_view name, std::uint64_t N, std::uint32_t M, std::size_t n) const;
   void check_open() const;
   void flush_buffer();
@@ -259,6 +280,7 @@ class Writer {
   std::vector<Chunk> pending_;             // entries of the current frame
   std::vector<std::byte> buffer_;          // chunk data not yet written
   std::uint64_t buffer_location_ = 0;      // file offset of buffer_[0]
+  std::size_t buffer_limit_ = std::size_t{8} << 20;
   std::uint64_t frame_ = 0;
 };
 

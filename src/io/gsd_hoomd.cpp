@@ -37,23 +37,9 @@ constexpr const char* kAngmom = "particles/angmom";
 constexpr const char* kImage = "particles/image";
 
 template <class T>
-EncodedChunk encode(const T* data, std::uint64_t N, std::uint32_t M) {
-  EncodedChunk e{type_of<T>(), N, M, std::vector<std::byte>(N * M * sizeof(T))};
-  if (!e.bytes.empty()) std::memcpy(e.bytes.data(), data, e.bytes.size());
-  return e;
+ChunkSource one_value(T v) {
+  return owned_source(std::vector<T>{v}, 1);
 }
-template <class T>
-EncodedChunk encode(const std::vector<T>& v, std::uint32_t M) {
-  return encode(v.data(), v.size() / M, M);
-}
-template <class T>
-EncodedChunk repeated(std::uint64_t N, std::vector<T> row) {
-  std::vector<T> all;
-  all.reserve(N * row.size());
-  for (std::uint64_t i = 0; i < N; ++i) all.insert(all.end(), row.begin(), row.end());
-  return encode(all.data(), N, static_cast<std::uint32_t>(row.size()));
-}
-
 // NT strings as an int8 NT x M array of 0-terminated rows, M = longest + 1.
 EncodedChunk encode_strings(const std::vector<std::string>& s) {
   std::size_t width = 0;
@@ -74,10 +60,46 @@ enum class Fallback {
 
 struct Planned {
   std::string name;
-  EncodedChunk chunk;
+  ChunkSource src;
   Fallback fallback;
-  std::optional<EncodedChunk> schema_default;
+  std::vector<std::byte> default_row;  // the schema default of every row; empty: none
 };
+
+template <class T>
+std::vector<std::byte> row_bytes(std::initializer_list<T> row) {
+  std::vector<std::byte> out(row.size() * sizeof(T));
+  std::memcpy(out.data(), row.begin(), out.size());
+  return out;
+}
+
+ChunkSource owned_source(EncodedChunk e) {
+  auto keep = std::make_shared<const EncodedChunk>(std::move(e));
+  return ChunkSource{keep->type, keep->N, keep->M, keep->bytes.empty() ? nullptr : keep->bytes.data(),
+                     {}, keep};
+}
+
+// Calls fn(bytes, rows) on successive whole rows of src, about `limit` bytes at a time (values in
+// memory are passed in place), until fn returns false. Returns false if fn did.
+template <class Fn>
+bool for_each_piece(const ChunkSource& src, std::size_t limit, Fn&& fn) {
+  const std::size_t row = src.row_bytes();
+  if (src.N == 0 || row == 0) return true;
+  const std::uint64_t step = std::max<std::uint64_t>(limit / row, 1);
+  std::vector<std::byte> scratch;
+  if (!src.data) scratch.resize(std::min<std::uint64_t>(step, src.N) * row);
+  for (std::uint64_t first = 0; first < src.N; first += step) {
+    const std::uint64_t n = std::min(step, src.N - first);
+    const std::byte* p = nullptr;
+    if (src.data) {
+      p = static_cast<const std::byte*>(src.data) + first * row;
+    } else {
+      src.fill(first, n, scratch.data());
+      p = scratch.data();
+    }
+    if (!fn(p, n)) return false;
+  }
+  return true;
+}
 
 [[noreturn]] void bad_frame(const std::filesystem::path& path, std::string_view what) {
   throw std::invalid_argument(fmt::format("{}: invalid HOOMD frame: {}", path.string(), what));
@@ -141,25 +163,43 @@ HoomdWriter HoomdWriter::append(const std::filesystem::path& path) {
                                          r.schema_version().minor));
   HoomdWriter w(Writer::append(path, "hoomd"));
   if (r.nframes() == 0) return w;
-  // Later frames are written against frame 0, so learn what frame 0 holds.
+  // Later frames are written against frame 0, so learn where frame 0's chunks are.
   if (r.has(0, kN)) w.frame0_N_ = r.read<std::uint32_t>(0, kN, 1, 1)[0];
   for (const char* name : {kDimensions, kTypes, kTypeShapes, kTypeId, kDiameter, kOrientation,
                            kVelocity, kAngmom, kImage})
-    if (const Chunk* c = r.find(0, name))
-      w.frame0_[name] = EncodedChunk{c->type, c->N, c->M, r.read_bytes(*c)};
+    if (const Chunk* c = r.find(0, name)) w.frame0_[name] = *c;
   for (const auto& name : r.names_with_prefix(kLogPrefix))
     if (r.has(0, name)) w.frame0_logs_.push_back(name.substr(kLogPrefix.size()));
   return w;
 }
 
+FrameSource frame_source(const HoomdFrame& f) {
+  FrameSource s;
+  s.step = f.step;
+  s.dimensions = f.dimensions;
+  s.box = f.box;
+  s.N = f.N;
+  s.position = memory_source(f.position, 3);
+  s.orientation = memory_source(f.orientation, 4);
+  s.type_id = memory_source(f.type_id, 1);
+  s.diameter = memory_source(f.diameter, 1);
+  s.velocity = memory_source(f.velocity, 3);
+  s.angmom = memory_source(f.angmom, 4);
+  s.image = memory_source(f.image, 3);
+  s.types = f.types;
+  s.type_shapes = f.type_shapes;
+  for (const auto& [key, a] : f.log) {
+    ChunkSource c = memory_source(a.values, a.cols == 0 ? 1 : a.cols);
+    c.N = a.rows;
+    c.M = a.cols;
+    s.log.emplace(key, std::move(c));
+  }
+  return s;
+}
+
 void HoomdWriter::write_frame(const HoomdFrame& f) {
   const auto& path = file_.path();
   const std::uint64_t N = f.N;
-  const bool first = nframes() == 0;
-
-  // Validate everything before the first byte goes out.
-  if (f.dimensions != 2 && f.dimensions != 3)
-    bad_frame(path, fmt::format("dimensions = {}, must be 2 or 3", int{f.dimensions}));
   check_size(path, "position", f.position.size(), N, 3, false);
   check_size(path, "orientation", f.orientation.size(), N, 4, true);
   check_size(path, "type_id", f.type_id.size(), N, 1, true);
@@ -167,6 +207,58 @@ void HoomdWriter::write_frame(const HoomdFrame& f) {
   check_size(path, "velocity", f.velocity.size(), N, 3, true);
   check_size(path, "angmom", f.angmom.size(), N, 4, true);
   check_size(path, "image", f.image.size(), N, 3, true);
+  for (const auto& [key, a] : f.log)
+    if (a.cols == 0 || a.values.size() != a.rows * a.cols)
+      bad_frame(path, fmt::format("log '{}' has {} values for {} x {}", key, a.values.size(),
+                                  a.rows, a.cols));
+  write_frame(frame_source(f));
+}
+
+bool HoomdWriter::same_as(const ChunkSource& src, const Chunk& c) {
+  if (c.type != src.type || c.N != src.N || c.M != src.M) return false;
+  std::vector<std::byte> stored;
+  std::uint64_t offset = c.location;
+  return for_each_piece(src, file_.buffer_size(), [&](const std::byte* p, std::uint64_t rows) {
+    const std::size_t n = rows * src.row_bytes();
+    stored.resize(n);
+    file_.read_back(offset, n, stored.data());
+    offset += n;
+    return std::memcmp(p, stored.data(), n) == 0;
+  });
+}
+
+bool HoomdWriter::same_as(const ChunkSource& src, const std::vector<std::byte>& row) {
+  if (row.size() != src.row_bytes()) return false;
+  return for_each_piece(src, file_.buffer_size(), [&](const std::byte* p, std::uint64_t rows) {
+    for (std::uint64_t i = 0; i < rows; ++i)
+      if (std::memcmp(p + i * row.size(), row.data(), row.size()) != 0) return false;
+    return true;
+  });
+}
+
+void HoomdWriter::write_frame(const FrameSource& f) {
+  const auto& path = file_.path();
+  const std::uint64_t N = f.N;
+  const bool first = nframes() == 0;
+
+  // Validate everything before the first byte goes out.
+  if (f.dimensions != 2 && f.dimensions != 3)
+    bad_frame(path, fmt::format("dimensions = {}, must be 2 or 3", int{f.dimensions}));
+  const auto check = [&](std::string_view field, const ChunkSource& c, Type type, std::uint32_t M,
+                         bool optional) {
+    if (optional && !c.given()) return;
+    if (!c.given() && N > 0) bad_frame(path, fmt::format("{} is missing", field));
+    if (c.type != type || c.M != M || c.N != N)
+      bad_frame(path, fmt::format("{} is {} x {} {}, expected N x {} {} (N = {})", field, c.N, c.M,
+                                  type_name(c.type), M, type_name(type), N));
+  };
+  check("position", f.position, Type::float32, 3, N == 0);
+  check("orientation", f.orientation, Type::float32, 4, true);
+  check("type_id", f.type_id, Type::uint32, 1, true);
+  check("diameter", f.diameter, Type::float32, 1, true);
+  check("velocity", f.velocity, Type::float32, 3, true);
+  check("angmom", f.angmom, Type::float32, 4, true);
+  check("image", f.image, Type::int32, 3, true);
   for (const auto& t : f.types)
     if (t.empty() || t.find('\0') != std::string::npos)
       bad_frame(path, fmt::format("type name '{}' is empty or contains a 0 byte", t));
@@ -176,8 +268,15 @@ void HoomdWriter::write_frame(const HoomdFrame& f) {
     const auto it = frame0_.find(kTypes);
     NT = (!first && it != frame0_.end()) ? it->second.N : 1;
   }
-  for (std::uint32_t id : f.type_id)
-    if (id >= NT) bad_frame(path, fmt::format("type_id {} but there are {} types", id, NT));
+  if (f.type_id.given())
+    for_each_piece(f.type_id, file_.buffer_size(), [&](const std::byte* p, std::uint64_t rows) {
+      for (std::uint64_t i = 0; i < rows; ++i) {
+        std::uint32_t id;
+        std::memcpy(&id, p + 4 * i, 4);
+        if (id >= NT) bad_frame(path, fmt::format("type_id {} but there are {} types", id, NT));
+      }
+      return true;
+    });
   if (!f.type_shapes.empty() && f.type_shapes.size() != NT)
     bad_frame(path, fmt::format("{} type_shapes for {} types", f.type_shapes.size(), NT));
   for (const auto& s : f.type_shapes) {
@@ -187,9 +286,9 @@ void HoomdWriter::write_frame(const HoomdFrame& f) {
   }
   for (const auto& [key, a] : f.log) {
     if (key.empty()) bad_frame(path, "empty log key");
-    if (a.cols == 0 || a.values.size() != a.rows * a.cols)
-      bad_frame(path, fmt::format("log '{}' has {} values for {} x {}", key, a.values.size(),
-                                  a.rows, a.cols));
+    if (a.M == 0 || type_size(a.type) == 0 || a.type == Type::character || (a.N > 0 && !a.given()))
+      bad_frame(path, fmt::format("log '{}' ({} x {} {}) has no values", key, a.N, a.M,
+                                  type_name(a.type)));
     if (!first && std::find(frame0_logs_.begin(), frame0_logs_.end(), key) == frame0_logs_.end())
       bad_frame(path, fmt::format("log '{}' is not in frame 0 (the hoomd schema requires every "
                                   "log chunk to be present in frame 0)", key));
@@ -197,50 +296,52 @@ void HoomdWriter::write_frame(const HoomdFrame& f) {
 
   // What this frame holds, in schema order.
   std::vector<Planned> plan;
-  plan.push_back({kStep, encode(&f.step, 1, 1), Fallback::none, {}});
-  plan.push_back({kDimensions, encode(&f.dimensions, 1, 1), Fallback::global,
-                  encode<std::uint8_t>(std::vector<std::uint8_t>{3}, 1)});
-  plan.push_back({kBox, encode(f.box.data(), 6, 1), Fallback::none, {}});
-  plan.push_back({kN, encode(&f.N, 1, 1), Fallback::none, {}});
-  if (!f.types.empty())
-    plan.push_back({kTypes, encode_strings(f.types), Fallback::global, encode_strings({"A"})});
+  plan.push_back({kStep, one_value(f.step), Fallback::none, {}});
+  plan.push_back({kDimensions, one_value(f.dimensions), Fallback::global, row_bytes<std::uint8_t>({3})});
+  plan.push_back({kBox, owned_source(std::vector<float>(f.box.begin(), f.box.end()), 1),
+                  Fallback::none, {}});
+  plan.push_back({kN, one_value(f.N), Fallback::none, {}});
+  if (!f.types.empty()) {
+    // The default {"A"} is one row "A\0"; a reader sees it only when types is absent.
+    plan.push_back({kTypes, owned_source(encode_strings(f.types)), Fallback::global,
+                    f.types == std::vector<std::string>{"A"} ? row_bytes<std::int8_t>({'A', 0})
+                                                             : std::vector<std::byte>{}});
+  }
   if (!f.type_shapes.empty())
-    plan.push_back({kTypeShapes, encode_strings(f.type_shapes), Fallback::global, {}});
-  if (!f.type_id.empty())
-    plan.push_back({kTypeId, encode(f.type_id, 1), Fallback::per_particle,
-                    repeated<std::uint32_t>(N, {0})});
-  if (!f.diameter.empty())
-    plan.push_back({kDiameter, encode(f.diameter, 1), Fallback::per_particle, repeated<float>(N, {1})});
-  if (N > 0) plan.push_back({kPosition, encode(f.position, 3), Fallback::none, {}});
-  if (!f.orientation.empty())
-    plan.push_back({kOrientation, encode(f.orientation, 4), Fallback::per_particle,
-                    repeated<float>(N, {1, 0, 0, 0})});
-  if (!f.velocity.empty())
-    plan.push_back({kVelocity, encode(f.velocity, 3), Fallback::per_particle,
-                    repeated<float>(N, {0, 0, 0})});
-  if (!f.angmom.empty())
-    plan.push_back({kAngmom, encode(f.angmom, 4), Fallback::per_particle,
-                    repeated<float>(N, {0, 0, 0, 0})});
-  if (!f.image.empty())
-    plan.push_back({kImage, encode(f.image, 3), Fallback::per_particle,
-                    repeated<std::int32_t>(N, {0, 0, 0})});
+    plan.push_back({kTypeShapes, owned_source(encode_strings(f.type_shapes)), Fallback::global, {}});
+  if (f.type_id.given())
+    plan.push_back({kTypeId, f.type_id, Fallback::per_particle, row_bytes<std::uint32_t>({0})});
+  if (f.diameter.given())
+    plan.push_back({kDiameter, f.diameter, Fallback::per_particle, row_bytes<float>({1})});
+  if (N > 0) plan.push_back({kPosition, f.position, Fallback::none, {}});
+  if (f.orientation.given())
+    plan.push_back({kOrientation, f.orientation, Fallback::per_particle,
+                    row_bytes<float>({1, 0, 0, 0})});
+  if (f.velocity.given())
+    plan.push_back({kVelocity, f.velocity, Fallback::per_particle, row_bytes<float>({0, 0, 0})});
+  if (f.angmom.given())
+    plan.push_back({kAngmom, f.angmom, Fallback::per_particle, row_bytes<float>({0, 0, 0, 0})});
+  if (f.image.given())
+    plan.push_back({kImage, f.image, Fallback::per_particle, row_bytes<std::int32_t>({0, 0, 0})});
   for (const auto& [key, a] : f.log)
-    plan.push_back({std::string(kLogPrefix) + key, encode(a.values.data(), a.rows, a.cols),
-                    Fallback::none, {}});
+    plan.push_back({std::string(kLogPrefix) + key, a, Fallback::none, {}});
 
   // Leave out what a reader reconstructs exactly: frame 0's chunk or the schema default.
   for (const Planned& p : plan) {
     if (p.fallback != Fallback::none) {
-      const EncodedChunk* stand_in = p.schema_default ? &*p.schema_default : nullptr;
-      if (!first) {
-        const auto it = frame0_.find(p.name);
-        if (it != frame0_.end() && (p.fallback == Fallback::global || N == frame0_N_))
-          stand_in = &it->second;
-      }
-      if (stand_in != nullptr && *stand_in == p.chunk) continue;
+      bool omit = false;
+      const auto it = first ? frame0_.end() : frame0_.find(p.name);
+      if (it != frame0_.end() && (p.fallback == Fallback::global || N == frame0_N_))
+        omit = same_as(p.src, it->second);
+      else if (!p.default_row.empty())
+        omit = same_as(p.src, p.default_row);
+      if (omit) continue;
     }
-    file_.write_chunk(p.name, p.chunk.type, p.chunk.N, p.chunk.M, p.chunk.bytes.data());
-    if (first && p.fallback != Fallback::none) frame0_[p.name] = p.chunk;
+    const ChunkSource& c = p.src;
+    const std::uint64_t at = c.fill ? file_.write_chunk(p.name, c.type, c.N, c.M, c.fill)
+                                    : file_.write_chunk(p.name, c.type, c.N, c.M, c.data);
+    if (first && p.fallback != Fallback::none)
+      frame0_[p.name] = Chunk{0, c.N, at, c.M, 0, c.type};
   }
   file_.end_frame();
   if (first) {
@@ -425,11 +526,15 @@ void sync_directory(const std::filesystem::path& file) {
 
 }  // namespace
 
-void write_frame_atomic(const std::filesystem::path& path, const HoomdFrame& frame) {
+namespace {
+
+template <class Frame>
+void write_atomic(const std::filesystem::path& path, const Frame& frame, std::size_t buffer_size) {
   std::filesystem::path tmp = path;
   tmp += ".tmp";
   try {
     HoomdWriter w = HoomdWriter::create(tmp);
+    if (buffer_size > 0) w.set_buffer_size(buffer_size);
     w.write_frame(frame);
     w.sync();
     w.close();
@@ -438,12 +543,28 @@ void write_frame_atomic(const std::filesystem::path& path, const HoomdFrame& fra
     if (ec)
       throw std::runtime_error(fmt::format("{}: cannot rename {} over it: {}", path.string(),
                                            tmp.string(), ec.message()));
+  } catch (const std::runtime_error& e) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw std::runtime_error(fmt::format("{} (the previous {} is unchanged)", e.what(),
+                                         path.filename().string()));
   } catch (...) {
     std::error_code ignored;
     std::filesystem::remove(tmp, ignored);
     throw;
   }
   sync_directory(path);
+}
+
+}  // namespace
+
+void write_frame_atomic(const std::filesystem::path& path, const HoomdFrame& frame) {
+  write_atomic(path, frame, 0);
+}
+
+void write_frame_atomic(const std::filesystem::path& path, const FrameSource& frame,
+                        std::size_t buffer_size) {
+  write_atomic(path, frame, buffer_size);
 }
 
 }  // namespace hb::gsd
