@@ -85,7 +85,14 @@ def run_job(spec: dict, slurm: bool = False) -> int:
 
     def forward(sig, _frame):
         got["signal"] = sig
-        if child is not None and child.poll() is None:
+        if child is None or child.poll() is not None:
+            return
+        if slurm:
+            # srun cancels its step (SIGKILL) on SIGTERM; the step's own SIGTERM comes from
+            # Slurm (in the background: scancel may wait while the job is being changed)
+            subprocess.Popen(["scancel", "--quiet", "--signal=TERM", os.environ["SLURM_JOB_ID"]],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        else:
             child.send_signal(signal.SIGTERM if sig == signal.SIGUSR1 else sig)
 
     for s in (signal.SIGTERM, signal.SIGINT, signal.SIGUSR1):
@@ -96,7 +103,7 @@ def run_job(spec: dict, slurm: bool = False) -> int:
         lf.flush()
         child = subprocess.Popen(launch, stdout=lf, stderr=subprocess.PIPE, text=True)
         if got["signal"]:  # a stop request that came while it was starting
-            child.send_signal(signal.SIGTERM)
+            forward(got["signal"], None)
         err = ""
         while True:
             try:

@@ -7,13 +7,13 @@
 #     minutes): warned by SIGUSR1 (--signal=B:USR1@60) it checkpoints, requeues and resumes;
 #  3. both give results identical bit for bit to the local executor's (python/campaign_compare.py).
 # Not part of `make test` (it starts daemons); `scripts/validate.sh slurm` calls it.
-# Environment: HB (binary, default build/apps/hardbody/hardbody), WORK (default
+# Environment: HB (binary, default build/apps/hardbody/hardbody), SLURM_WORK (default
 # /tmp/hardbody-slurm-campaign; emptied first). Takes about 5 minutes on 2 cores.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 HB=$(realpath "${HB:-$root/build/apps/hardbody/hardbody}")
 [ -x "$HB" ] || { echo "build first: make build (or set HB)" >&2; exit 1; }
-work=${WORK:-/tmp/hardbody-slurm-campaign}
+work=${SLURM_WORK:-/tmp/hardbody-slurm-campaign}
 "$root/scripts/slurm-local.sh" >/dev/null
 rm -rf "$work"
 mkdir -p "$work/local" "$work/slurm"
@@ -49,11 +49,13 @@ for _ in $(seq 600); do
     idx=${t#*_}
     name=$(/usr/bin/python3 -c "import json,glob; print(json.load(open(sorted(glob.glob('$work/slurm/small/.campaign/slurm/*.job.json'))[-1]))['names'][$idx])")
     if [ -f "$work/slurm/small/runs/$name/checkpoint.gsd" ] && [ ! -f "$work/slurm/small/runs/$name/summary.json" ]; then
-      scancel --signal=TERM "$t" 2>/dev/null || continue
+      # (in the background: scancel keeps retrying while the requeued task cannot be altered)
+      scancel --signal=TERM "$t" 2>/dev/null & scancel_pid=$!
       for _ in $(seq 300); do  # until the attempt has ended (srun passes the signal on)
         grep -q "== exit" "$work/slurm/small/logs/$name.log" 2>/dev/null && break
         sleep 0.2
       done
+      kill "$scancel_pid" 2>/dev/null || true
       if grep -q "== exit 143" "$work/slurm/small/logs/$name.log"; then term_task=$name; break 2; fi
     fi
   done
@@ -80,7 +82,7 @@ grep -q "restart 1" "$log" || fail "$term_task was not requeued: $log"
 grep -A2 "restart 1" "$log" | grep -q -- "--resume" || fail "$term_task did not resume: $log"
 tail -n 1 "$log" | grep -q "== exit 0" || fail "$term_task did not finish: $log"
 # the long run: stopped by the time-limit warning at least once, then resumed to its end
-log=$(ls "$work"/slurm/long/logs/*.log | grep -v slurm-)
+log=$work/slurm/long/logs/seed=7.log
 [ "$(grep -c "== exit 143" "$log")" -ge 1 ] || fail "the long run never reached its time limit: $log"
 grep -q "restart 1" "$log" || fail "the long run was not requeued: $log"
 tail -n 1 "$log" | grep -q "== exit 0" || fail "the long run did not finish: $log"

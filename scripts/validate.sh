@@ -18,6 +18,7 @@
 #                   uniform-density inertia) at phi = 0.40, NNL -> docs/validation/runs/tops.summary.json
 #                   (issue 11: per-axis rotational temperatures, energy drift)
 #   tables          only rebuild the .md tables from the stored summaries
+#   slurm           campaigns on a one-node Slurm cluster (scripts/test-slurm-campaign.sh; issue 14)
 #   `scripts/validate.sh 1000000` (a number first) is the old form: the ellipsoids group.
 # Environment: HB (binary, default build/apps/hardbody/hardbody), WORK (run directories, default
 #   /tmp/hardbody-validate; GSD/log outputs stay there), SQ_P ("2 4 8 12 16"), SQ_X0 ("2 0.5"),
@@ -188,6 +189,11 @@ count = 256
 shape = { type = "ellipsoid", semi_axes = [1.5, 1.0, 0.6] }
 TOML
       sections nnl 2.0 50.0; } > "$work/tops.toml" && run tops ;;
+  slurm)
+    # issue 14: campaigns as Slurm job arrays on a one-node cluster (scripts/slurm-local.sh starts
+    # munge, slurmctld, slurmd): scancel --signal=TERM and a time limit, requeued and resumed,
+    # results identical to the local executor's (scripts/test-slurm-campaign.sh; ~5 minutes)
+    HB="$HB" exec scripts/test-slurm-campaign.sh ;;
   tables) ;;
   *) echo "unknown group '$group' (ellipsoids, ellipsoids-045, superquadrics, sq-taus, sq-vs-ellipsoid, tables)" >&2
      exit 2 ;;
