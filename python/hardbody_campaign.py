@@ -397,8 +397,7 @@ def main(argv: list[str]) -> int:
         argv = ["run", *argv]
     a = p.parse_args(argv)
     if a.campaign is None:
-        p.print_usage(sys.stderr)
-        say("error: give a campaign file")
+        say("error: give a campaign file: hardbody campaign [status|results] CAMPAIGN.toml (docs/campaigns.md)")
         return EXIT_BAD_INPUT
     if a.jobs is not None and a.jobs < 1:
         say("error: --jobs: expected an integer >= 1")

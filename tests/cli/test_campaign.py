@@ -199,3 +199,5 @@ def test_missing_campaign_file_exits_2(tmp_path):
     assert r.returncode == 2 and "none.toml: cannot open" in r.stderr, r.stderr
     r = campaign(["status", str(tmp_path)], tmp_path)
     assert r.returncode == 2 and "is a directory" in r.stderr, r.stderr
+    r = campaign([], tmp_path)
+    assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and "give a campaign file" in r.stderr, r.stderr
