@@ -1,13 +1,18 @@
 #include "io/config.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
 #include <toml++/toml.h>
 
+#include "io/resources.hpp"
+#include "io/suggest.hpp"
 #include "shapes/codec.hpp"
 #include "shapes/inertia.hpp"
 
@@ -44,6 +49,7 @@ const std::vector<KeySpec>& key_specs() {
       {"output", "snapshot_interval", Kind::Float, "simulated time between trajectory frames (each checked for overlaps)"},
       {"output", "checkpoint_interval", Kind::Float, "wall seconds between checkpoints (also written on SIGINT/SIGTERM and failures)"},
       {"output", "trajectory", Kind::Bool, "write trajectory.gsd"},
+      {"output", "max_output_gb", Kind::Float, "limit on the files of a run (trajectory, logs, tables, checkpoint; estimated from the config before the start, in 1e9 bytes): a run that would write more is refused"},
       {"init", "method", Kind::String, "\"auto\" (default): \"lattice\" for one species of equal spheres, \"grow\" otherwise; \"grow\": Lubachevsky-Stillinger growth from a dilute placement at init.phi0; \"lattice\": (stretched) lattice at the target; mixtures always grow from a random placement"},
       {"init", "phi0", Kind::Float, "packing fraction of the dilute start that is grown"},
       {"init", "growth_rate", Kind::Float, "d(scale)/dt of the growth (scale 1 = target size)"},
@@ -67,27 +73,12 @@ const std::map<std::string, std::map<std::string, Kind>>& schema() {
   return s;
 }
 
-// Keys of [shape]: its type, the scalar inertia, and the parameters of every registered shape
-// (which ones apply to the chosen type is checked when the shape is decoded).
-bool is_shape_section_key(const std::string& key) {
-  if (key == "type" || key == "inertia") return true;
-  const auto keys = all_shape_keys();
-  return std::find(keys.begin(), keys.end(), key) != keys.end();
-}
-
-const char* kind_name(Kind k) {
-  switch (k) {
-    case Kind::Int: return "an integer";
-    case Kind::Float: return "a number";
-    case Kind::String: return "a string";
-    case Kind::Bool: return "true or false";
-    case Kind::Vec3: return "an array of 3 numbers";
-  }
-  return "?";
-}
-
+// Where a value came from: "file:line", or the --set option that gave it ("--set k=v": its
+// nodes are parsed with that source name, see apply_override).
+constexpr std::string_view kSetSource = "--set ";
 std::string where(const std::string& file, const toml::node& n) {
   const auto& src = n.source();
+  if (src.path && src.path->rfind(kSetSource, 0) == 0) return *src.path;
   if (src.begin.line > 0) return fmt::format("{}:{}", file, src.begin.line);
   return file;
 }
@@ -227,9 +218,6 @@ SpeciesTable read_species(const Reader& r, const toml::array& arr) {
       const std::string name(kk.str());
       if (name == "sites")
         r.fail(&vv, key("sites"), "square-well sites are not supported yet");
-      if (name != "name" && name != "count" && name != "shape" && name != "mass" &&
-          name != "inertia" && name != "polydispersity")
-        throw ConfigError(fmt::format("{}: unknown key '{}'", where(r.file, vv), key(name.c_str())));
     }
     Species sp;
     const auto* name = t->get("name");
@@ -271,9 +259,6 @@ SpeciesTable read_species(const Reader& r, const toml::array& arr) {
     if (const auto* pn = t->get("polydispersity")) {
       const auto* pt = pn->as_table();
       if (!pt) r.fail(pn, key("polydispersity"), "must be a table { distribution = \"gaussian\", width = 0.1 }");
-      for (const auto& [kk, vv] : *pt)
-        if (kk.str() != "distribution" && kk.str() != "width")
-          throw ConfigError(fmt::format("{}: unknown key '{}.{}'", where(r.file, vv), key("polydispersity"), kk.str()));
       const auto* d = pt->get("distribution");
       const std::string dist = d && d->value_exact<std::string>() ? *d->value_exact<std::string>() : "";
       if (dist == "gaussian") sp.poly.distribution = Polydispersity::Distribution::gaussian;
@@ -290,53 +275,154 @@ SpeciesTable read_species(const Reader& r, const toml::array& arr) {
   return out;
 }
 
-void check_unknown_keys(const std::string& file, const toml::table& root) {
-  const auto& s = schema();
-  for (const auto& [k, v] : root) {
-    const std::string sec(k.str());
-    if (sec == "species") {
-      if (!v.as_array()) throw ConfigError(fmt::format("{}: 'species' must be an array of tables [[species]]", where(file, v)));
-      continue;  // keys checked by read_species
-    }
-    if (sec == "shape") {
-      const auto* t = v.as_table();
-      if (!t) throw ConfigError(fmt::format("{}: 'shape' must be a table [shape]", where(file, v)));
-      for (const auto& [kk, vv] : *t)
-        if (!is_shape_section_key(std::string(kk.str())))
-          throw ConfigError(fmt::format("{}: unknown key 'shape.{}'", where(file, vv), kk.str()));
+// ---- unknown keys: every one of a config in one message, each with its place and the nearest
+// known key ("did you mean"), also across sections ("system.time" -> "run.time").
+
+const std::vector<std::string> kSpeciesKeys{"name", "count", "shape", "mass", "inertia", "polydispersity"};
+const std::vector<std::string> kPolydispersityKeys{"distribution", "width"};
+
+std::vector<std::string> section_keys(const std::string& sec) {
+  std::vector<std::string> out;
+  if (sec == "shape") {
+    out = {"type", "inertia"};
+    for (const auto& k : all_shape_keys()) out.push_back(k);
+  } else if (auto it = schema().find(sec); it != schema().end()) {
+    for (const auto& kv : it->second) out.push_back(kv.first);
+  }
+  return out;
+}
+
+std::vector<std::string> section_names() {
+  std::vector<std::string> out{"shape", "species"};
+  for (const auto& kv : schema()) out.push_back(kv.first);
+  return out;
+}
+
+// The known key nearest to `key` of section `sec` ("sec.k"), else the same or a near key of
+// another section ("other.k"); "" when nothing is near.
+std::string suggest_key(const std::string& sec, const std::string& key) {
+  if (auto k = nearest_key(key, section_keys(sec)); !k.empty()) return sec + "." + k;
+  std::vector<std::string> full, bare;
+  for (const auto& other : section_names())
+    if (other != sec && other != "species")
+      for (const auto& k : section_keys(other)) {
+        full.push_back(other + "." + k);
+        bare.push_back(k);
+      }
+  for (std::size_t i = 0; i < bare.size(); ++i)
+    if (bare[i] == key) return full[i];
+  const std::string k = nearest_key(key, bare);
+  for (std::size_t i = 0; i < bare.size(); ++i)
+    if (bare[i] == k && !k.empty()) return full[i];
+  return "";
+}
+
+std::string mean(const std::string& pick) { return pick.empty() ? "" : fmt::format(" (did you mean '{}'?)", pick); }
+
+struct Unknown {
+  const toml::node* node;
+  std::string message;
+};
+
+// Keys of a table that `known` does not list, as "place: unknown key 'prefix.key' (did you mean ...)".
+void unknown_in(const std::string& file, const toml::table& t, const std::vector<std::string>& known,
+                const std::string& prefix, std::vector<Unknown>& out, const std::vector<std::string>& skip = {}) {
+  for (const auto& [k, v] : t) {
+    const std::string key(k.str());
+    if (std::find(known.begin(), known.end(), key) != known.end() ||
+        std::find(skip.begin(), skip.end(), key) != skip.end())
       continue;
-    }
-    auto it = s.find(sec);
-    if (it == s.end()) {
-      throw ConfigError(fmt::format("{}: unknown section or key '{}'", where(file, v), sec));
-    }
-    const auto* t = v.as_table();
-    if (!t) throw ConfigError(fmt::format("{}: '{}' must be a table [{}]", where(file, v), sec, sec));
-    for (const auto& [kk, vv] : *t) {
-      const std::string key(kk.str());
-      if (!it->second.count(key))
-        throw ConfigError(fmt::format("{}: unknown key '{}.{}'", where(file, vv), sec, key));
-    }
+    const std::string pick = nearest_key(key, known);
+    out.push_back({&v, fmt::format("{}: unknown key '{}{}'{}", where(file, v), prefix, key,
+                                   mean(pick.empty() ? "" : prefix + pick))});
   }
 }
 
-// Applies one --set override "section.key=value" to the parsed table.
+// Every unknown section and key of the config (sections, [shape], each [[species]] entry, its
+// shape and polydispersity), reported together; wrong section types are reported at once.
+void check_unknown_keys(const std::string& file, const toml::table& root) {
+  const auto& s = schema();
+  std::vector<Unknown> bad;
+  for (const auto& [k, v] : root) {
+    const std::string sec(k.str());
+    if (sec == "species") {
+      const auto* arr = v.as_array();
+      if (!arr) throw ConfigError(fmt::format("{}: 'species' must be an array of tables [[species]]", where(file, v)));
+      for (std::size_t i = 0; i < arr->size(); ++i) {
+        const auto* t = arr->get(i)->as_table();
+        if (!t) continue;  // reported by read_species
+        const std::string prefix = fmt::format("species[{}].", i);
+        unknown_in(file, *t, kSpeciesKeys, prefix, bad, {"sites"});
+        if (const auto* sh = t->get_as<toml::table>("shape")) {
+          std::vector<std::string> known{"type"};
+          for (const auto& key : all_shape_keys()) known.push_back(key);
+          unknown_in(file, *sh, known, prefix + "shape.", bad);
+        }
+        if (const auto* pd = t->get_as<toml::table>("polydispersity"))
+          unknown_in(file, *pd, kPolydispersityKeys, prefix + "polydispersity.", bad);
+      }
+      continue;
+    }
+    if (s.find(sec) == s.end() && sec != "shape") {
+      if (v.as_table()) {
+        const std::string pick = nearest_key(sec, section_names());
+        bad.push_back({&v, fmt::format("{}: unknown section or key '{}'{}", where(file, v), sec,
+                                       pick.empty() ? "" : fmt::format(" (did you mean [{}]?)", pick))});
+      } else {
+        // a key above the first section header
+        bad.push_back({&v, fmt::format("{}: unknown section or key '{}'{}", where(file, v), sec,
+                                       mean(suggest_key("", sec)))});
+      }
+      continue;
+    }
+    const auto* t = v.as_table();
+    if (!t) throw ConfigError(fmt::format("{}: '{}' must be a table [{}]", where(file, v), sec, sec));
+    const std::vector<std::string> known = section_keys(sec);
+    for (const auto& [kk, vv] : *t) {
+      const std::string key(kk.str());
+      if (std::find(known.begin(), known.end(), key) == known.end())
+        bad.push_back({&vv, fmt::format("{}: unknown key '{}.{}'{}", where(file, vv), sec, key,
+                                        mean(suggest_key(sec, key)))});
+    }
+  }
+  if (bad.empty()) return;
+  // in the order of the file (the tables iterate by name); --set values last
+  auto line = [](const Unknown& u) {
+    const auto& src = u.node->source();
+    const bool set = src.path && src.path->rfind(kSetSource, 0) == 0;
+    return src.begin.line > 0 && !set ? std::size_t(src.begin.line) : std::size_t(-1);
+  };
+  std::stable_sort(bad.begin(), bad.end(), [&](const Unknown& a, const Unknown& b) { return line(a) < line(b); });
+  std::string msg;
+  for (const auto& b : bad) msg += (msg.empty() ? "" : "; ") + b.message;
+  throw ConfigError(msg);
+}
+
+// Applies one --set override "section.key=value" to the parsed table. The value keeps the
+// source name "--set section.key=value", so that every message about it names the option, never
+// a line of the file.
 void apply_override(toml::table& root, const std::string& ov) {
+  const std::string source = std::string(kSetSource) + ov;
   const auto eq = ov.find('=');
   const auto dot = ov.find('.');
   if (eq == std::string::npos || dot == std::string::npos || dot > eq)
     throw ConfigError(fmt::format("--set '{}': expected section.key=value", ov));
-  const std::string sec = ov.substr(0, dot), key = ov.substr(dot + 1, eq - dot - 1);
-  std::string value = ov.substr(eq + 1);
+  auto trim = [](std::string x) {
+    const auto b = x.find_first_not_of(" \t"), e = x.find_last_not_of(" \t");
+    return b == std::string::npos ? std::string() : x.substr(b, e - b + 1);
+  };
+  const std::string sec = trim(ov.substr(0, dot)), key = trim(ov.substr(dot + 1, eq - dot - 1));
+  const std::string value = trim(ov.substr(eq + 1));
+  if (sec.empty() || key.empty()) throw ConfigError(fmt::format("--set '{}': expected section.key=value", ov));
   toml::table parsed;
   try {
-    parsed = toml::parse(std::string_view("v = " + value), std::string_view("--set"));
+    parsed = toml::parse(std::string_view("v = " + value), source);
   } catch (const toml::parse_error&) {
     // bare words are strings: --set neighbors.method=cells
     try {
-      parsed = toml::parse(std::string_view("v = \"" + value + "\""), std::string_view("--set"));
+      parsed = toml::parse(std::string_view("v = \"" + value + "\""), source);
     } catch (const toml::parse_error& e) {
-      throw ConfigError(fmt::format("--set '{}': cannot parse value: {}", ov, e.description()));
+      throw ConfigError(fmt::format("{}: cannot parse the value: {}", source, e.description()));
     }
   }
   if (root.contains(sec) && !root.get_as<toml::table>(sec))
@@ -347,7 +433,8 @@ void apply_override(toml::table& root, const std::string& ov) {
     root.insert(sec, toml::table{});
     t = root.get_as<toml::table>(sec);
   }
-  t->insert_or_assign(key, *parsed.get("v"));
+  // moved, not copied: a copied toml node forgets its source
+  parsed.get("v")->visit([&](auto&& v) { t->insert_or_assign(key, std::move(v)); });
 }
 
 Config validate(const std::string& file, const toml::table& root) {
@@ -396,6 +483,7 @@ Config validate(const std::string& file, const toml::table& root) {
   r.real("output", "snapshot_interval", c.snapshot_interval);
   r.real("output", "checkpoint_interval", c.checkpoint_interval);
   r.boolean("output", "trajectory", c.trajectory);
+  r.real("output", "max_output_gb", c.max_output_gb);
   r.string("init", "method", c.init_method);
   r.real("init", "phi0", c.init_phi0);
   r.real("init", "growth_rate", c.init_growth_rate);
@@ -446,6 +534,21 @@ Config validate(const std::string& file, const toml::table& root) {
   }
   if (c.equilibrate_time < 0.0) bad("run", "equilibrate_time", "must not be negative");
   if (!(c.time > 0.0)) bad("run", "time", "must be positive");
+  {
+    // Time stamps are doubles: beyond ~1e12 thermal times tau = r / sqrt(kT / m) of the smallest,
+    // lightest body they cannot resolve its collisions (and such a run would never end).
+    double r_min = kInf, m_min = kInf;
+    for (const Species& sp : c.species) {
+      r_min = std::min(r_min, half_extents(sp.shape).minCoeff());
+      m_min = std::min(m_min, sp.mass);
+    }
+    const double tau = r_min / std::sqrt(c.temperature / m_min);
+    const double t_end = c.equilibrate_time + c.time;
+    if (!(t_end / tau <= 1e12))
+      bad("run", c.equilibrate_time > c.time ? "equilibrate_time" : "time",
+          fmt::format("run.equilibrate_time + run.time = {:.3g} is {:.3g} thermal times of the smallest body "
+                      "(r / sqrt(kT / m) = {:.3g}); at most 1e12 (time stamps are doubles)", t_end, t_end / tau, tau));
+  }
   // cells for spheres (their analytic contact times are cheap), neighbour lists as soon as one
   // species is not a sphere (whichever species comes first)
   if (!r.get("neighbors", "method")) {
@@ -460,6 +563,7 @@ Config validate(const std::string& file, const toml::table& root) {
   if (!(c.log_interval > 0.0)) bad("output", "log_interval", "must be positive");
   if (!(c.snapshot_interval > 0.0)) bad("output", "snapshot_interval", "must be positive");
   if (!(c.checkpoint_interval > 0.0)) bad("output", "checkpoint_interval", "must be positive");
+  if (!(c.max_output_gb > 0.0)) bad("output", "max_output_gb", "must be positive");
   if (c.init_method != "auto" && c.init_method != "grow" && c.init_method != "lattice")
     bad("init", "method", fmt::format("must be \"auto\", \"grow\" or \"lattice\" (got \"{}\")", c.init_method));
   // "auto": one species of equal spheres starts on the FCC lattice at the target; everything else
@@ -469,11 +573,17 @@ Config validate(const std::string& file, const toml::table& root) {
   if (!(c.init_phi0 > 0.0 && c.init_phi0 < 0.5)) bad("init", "phi0", "must be in (0, 0.5)");
   if (!(c.init_growth_rate > 0.0)) bad("init", "growth_rate", "must be positive");
   if (c.obs_interval < 0.0) bad("observables", "interval", "must not be negative (0 switches it off)");
-  if (c.obs_origin_every < 1) bad("observables", "origin_every", "must be at least 1");
+  if (c.obs_origin_every < 1 || c.obs_origin_every > 1000000000)
+    bad("observables", "origin_every", "must be in 1..1e9");
   if (c.obs_interval > 0.0 && !(c.obs_max_lag >= c.obs_interval))
     bad("observables", "max_lag", "must be at least observables.interval");
+  // the lag grid has max_lag / interval entries (a table row each)
+  if (c.obs_interval > 0.0 && c.obs_max_lag / c.obs_interval > 1e8)
+    bad("observables", "max_lag", fmt::format("is {:.3g} observables.interval; at most 1e8 lags (a larger "
+                                              "observables.interval, or a shorter max_lag)",
+                                              c.obs_max_lag / c.obs_interval));
   if (!(c.obs_q > 0.0)) bad("observables", "q", "must be positive");
-  if (c.obs_q_vectors < 1) bad("observables", "q_vectors", "must be at least 1");
+  if (c.obs_q_vectors < 1 || c.obs_q_vectors > 100000) bad("observables", "q_vectors", "must be in 1..100000");
   if (c.gr_interval < 0.0) bad("observables", "gr_interval", "must not be negative (0 switches it off)");
   if (c.gr_bins < 1 || c.gr_bins > 100000) bad("observables", "gr_bins", "must be in 1..100000");
   return c;
@@ -495,16 +605,102 @@ Config parse_config(const std::string& text, const std::string& name,
 }
 
 Config load_config(const std::string& path, const std::vector<std::string>& overrides) {
+  // (an ifstream opens a directory, and reading it gives an empty text)
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw ConfigError(fmt::format("{}: is a directory, not a config file", path));
+  errno = 0;
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw ConfigError(fmt::format("{}: cannot open config file", path));
+  if (!in)
+    throw ConfigError(fmt::format("{}: cannot open config file ({})", path,
+                                  errno ? std::strerror(errno) : "unknown reason"));
   std::stringstream ss;
   ss << in.rdbuf();
   if (in.bad()) throw ConfigError(fmt::format("{}: cannot read config file", path));
-  return parse_config(ss.str(), path, overrides);
+  Config c = parse_config(ss.str(), path, overrides);
+  check_resources(c, available_memory_bytes());
+  return c;
 }
 
+namespace {
+
+// ---- the resolved config as TOML text. toml++ prints a double with 17 significant digits
+// (0.10000000000000001); these print the shortest digits that read back the same double.
+
+std::string toml_number(double x) {
+  std::string t = fmt::format("{}", x);  // shortest round trip; "1e+20", "inf", "nan"
+  if (t.find_first_of(".en") == std::string::npos) t += ".0";  // a float, not an integer
+  return t;
+}
+
+std::string toml_string(std::string_view x) {
+  const bool literal = std::none_of(x.begin(), x.end(), [](char ch) {
+    return ch == '\'' || static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f;
+  });
+  if (literal) return "'" + std::string(x) + "'";
+  std::string out = "\"";
+  for (char ch : x) {
+    if (ch == '"' || ch == '\\') out += '\\', out += ch;
+    else if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f) out += fmt::format("\\u{:04X}", int(ch));
+    else out += ch;
+  }
+  return out + "\"";
+}
+
+std::string toml_key(std::string_view k) {
+  const bool bare = !k.empty() && std::all_of(k.begin(), k.end(), [](char ch) {
+    return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-';
+  });
+  return bare ? std::string(k) : toml_string(k);
+}
+
+// A value: scalars, arrays "[ a, b ]" and tables inline "{ k = v, ... }".
+std::string toml_value(const toml::node& n) {
+  if (auto d = n.value_exact<double>()) return toml_number(*d);
+  if (auto i = n.value_exact<int64_t>()) return fmt::format("{}", *i);
+  if (auto b = n.value_exact<bool>()) return *b ? "true" : "false";
+  if (auto str = n.value_exact<std::string>()) return toml_string(*str);
+  if (const auto* a = n.as_array()) {
+    std::string out = "[";
+    for (std::size_t k = 0; k < a->size(); ++k) out += (k ? ", " : " ") + toml_value(*a->get(k));
+    return out + (a->empty() ? "]" : " ]");
+  }
+  if (const auto* t = n.as_table()) {
+    std::string out = "{";
+    for (const auto& [k, v] : *t) out += (out.size() > 1 ? ", " : " ") + toml_key(k.str()) + " = " + toml_value(v);
+    return out + (t->empty() ? "}" : " }");
+  }
+  throw std::logic_error("to_toml: a value of a kind the config does not use");
+}
+
+// Sections in reading order ([system] and the bodies first), arrays of tables as [[name]].
+std::string toml_text(const toml::table& root) {
+  std::vector<std::string> order{"system", "shape", "species", "run", "neighbors", "init", "solver", "output", "observables"};
+  for (const auto& [k, v] : root)
+    if (std::find(order.begin(), order.end(), k.str()) == order.end()) order.emplace_back(k.str());
+  std::string out;
+  auto body = [&](const toml::table& t) {
+    for (const auto& [k, v] : t) out += toml_key(k.str()) + " = " + toml_value(v) + "\n";
+  };
+  for (const auto& sec : order) {
+    const auto* n = root.get(sec);
+    if (!n) continue;
+    if (const auto* t = n->as_table()) {
+      out += "\n[" + toml_key(sec) + "]\n";
+      body(*t);
+    } else if (const auto* a = n->as_array()) {
+      for (const auto& e : *a) {
+        out += "\n[[" + toml_key(sec) + "]]\n";
+        body(*e.as_table());
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 std::string to_toml(const Config& c) {
-  auto arr = [](const Vec3& v) { return toml::array{v.x(), v.y(), v.z()}; };
   toml::table root{
       {"system", toml::table{{"packing_fraction", c.packing_fraction},
                              {"seed", int64_t(c.seed)},
@@ -517,7 +713,8 @@ std::string to_toml(const Config& c) {
       {"output", toml::table{{"log_interval", c.log_interval},
                              {"snapshot_interval", c.snapshot_interval},
                              {"checkpoint_interval", c.checkpoint_interval},
-                             {"trajectory", c.trajectory}}},
+                             {"trajectory", c.trajectory},
+                             {"max_output_gb", c.max_output_gb}}},
       {"observables", toml::table{{"interval", c.obs_interval},
                                   {"origin_every", int64_t(c.obs_origin_every)},
                                   {"max_lag", c.obs_max_lag},
@@ -552,9 +749,7 @@ std::string to_toml(const Config& c) {
   init.insert("phi0", c.init_phi0);
   init.insert("growth_rate", c.init_growth_rate);
   root.insert("init", init);
-  std::ostringstream os;
-  os << "# hardbody resolved configuration (every key, defaults filled in)\n" << root << "\n";
-  return os.str();
+  return "# hardbody resolved configuration (every key, defaults filled in)\n" + toml_text(root);
 }
 
 namespace {

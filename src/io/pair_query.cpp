@@ -16,6 +16,7 @@
 #include "geometry/penetration.hpp"
 #include "io/run.hpp"
 #include "io/shape_io.hpp"
+#include "io/suggest.hpp"
 #include "shapes/codec.hpp"
 
 namespace hb {
@@ -38,37 +39,6 @@ struct Where {
 };
 
 // ---- unknown keys ----------------------------------------------------------------------------
-
-// Optimal string alignment distance (edits: insert, delete, substitute, swap two neighbours),
-// ignoring case: "Radius", "raduis" and "radus" are all one edit from "radius".
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  auto low = [](char c) { return char(std::tolower(static_cast<unsigned char>(c))); };
-  std::vector<std::vector<std::size_t>> d(a.size() + 1, std::vector<std::size_t>(b.size() + 1));
-  for (std::size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
-  for (std::size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i)
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t cost = low(a[i - 1]) == low(b[j - 1]) ? 0 : 1;
-      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + cost});
-      if (i > 1 && j > 1 && low(a[i - 1]) == low(b[j - 2]) && low(a[i - 2]) == low(b[j - 1]))
-        d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
-    }
-  return d[a.size()][b.size()];
-}
-
-// " (did you mean 'x'?)" for the nearest known key within a third of the key's length.
-std::string did_you_mean(const std::string& key, const std::vector<std::string>& known) {
-  std::size_t best = std::max<std::size_t>(1, key.size() / 3) + 1;
-  std::string pick;
-  for (const auto& k : known) {
-    const std::size_t e = edit_distance(key, k);
-    if (e < best) {
-      best = e;
-      pick = k;
-    }
-  }
-  return pick.empty() ? "" : fmt::format(" (did you mean '{}'?)", pick);
-}
 
 // The keys of the format. The moving-body keys and t_max are known to both commands (a
 // contact-time line can be given to `hardbody distance`, which ignores them).

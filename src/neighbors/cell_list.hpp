@@ -2,7 +2,9 @@
 // touch sit in the same or adjacent cells (27-cell stencil). Bodies change cell only through
 // cell-crossing events, which the caller schedules from crossing_time().
 #pragma once
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <stdexcept>
 #include <vector>
@@ -10,6 +12,25 @@
 #include "math/types.hpp"
 
 namespace hb {
+
+// The width of the cells of a grid over the box L for n bodies: min_width, or wider so that there
+// are at most 64 cells per body (and 2^28 in all). A dilute box (phi = 1e-9) would otherwise ask
+// for ~1e11 empty cells; wider cells are as correct (a body still meets only the 27 cells around
+// it). A function of (L, min_width, n) alone: a checkpoint's cell coordinates fit the grid
+// rebuilt on restore. Throws std::invalid_argument when the box is narrower than min_width.
+inline double capped_cell_width(const Vec3& L, double min_width, std::size_t n_bodies) {
+  constexpr double kMaxCellsPerBody = 64.0, kMaxCells = double(1u << 28);
+  const double cap = std::min(kMaxCells, std::max(27.0, kMaxCellsPerBody * double(n_bodies)));
+  double w = min_width;
+  auto cells = [&] { return std::floor(L[0] / w) * std::floor(L[1] / w) * std::floor(L[2] / w); };
+  for (int k = 0; k < 3; ++k)
+    if (!(std::floor(L[k] / w) >= 1.0)) throw std::invalid_argument("box smaller than one cell");
+  if (cells() > cap) {
+    w *= std::cbrt(cells() / cap);
+    while (cells() > cap) w *= 1.0 + 1.0 / 64;
+  }
+  return w;
+}
 
 class CellList {
  public:
@@ -19,9 +40,10 @@ class CellList {
   CellList(const Vec3& L, double min_width, std::size_t n_bodies) { init(L, min_width, n_bodies); }
 
   void init(const Vec3& L, double min_width, std::size_t n_bodies) {
+    const double w = capped_cell_width(L, min_width, n_bodies);
+    auto count = [&](int k) { return std::floor(L[k] / w); };
     for (int k = 0; k < 3; ++k) {
-      int nc = static_cast<int>(std::floor(L[k] / min_width));
-      if (nc < 1) throw std::invalid_argument("box smaller than one cell");
+      int nc = static_cast<int>(std::max(1.0, count(k)));
       // With fewer than 3 cells the stencil would wrap onto itself; use one cell then.
       if (nc < 3) nc = 1;
       nc_[k] = nc;

@@ -47,6 +47,7 @@ struct Config {
   double snapshot_interval = 10.0;
   double checkpoint_interval = 600.0;  // wall seconds
   bool trajectory = true;
+  double max_output_gb = 20.0;  // a run whose files would exceed this (estimated) is refused
   // [init]  dense starts of non-spherical bodies
   std::string init_method = "auto";  // "grow" (Lubachevsky–Stillinger from init.phi0) | "lattice"
                                      // ("auto" is resolved by load_config)
