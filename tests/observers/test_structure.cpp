@@ -5,9 +5,11 @@
 #include <random>
 #include <sstream>
 
+#include "observers/pair_twin.hpp"
 #include "observers/structure.hpp"
 
 using namespace hb;
+using hb::test::all_pairs_histogram;
 
 namespace {
 
@@ -64,42 +66,23 @@ TEST(RadialDistribution, UniformPointsGiveOne) {
   EXPECT_NEAR(rdf.coordination().back(), nc, 5.0 * nc / std::sqrt(total));
 }
 
-TEST(RadialDistribution, CellsAndBruteForceAreIdentical) {
+TEST(RadialDistribution, ObserverMatchesTheAllPairsTwin) {
+  // Through the observer, including bodies exactly on the box faces; the whole pair search is
+  // compared with the all-pairs loop in test_pair_search.cpp.
   pcg32 rng(22);
-  struct Case {
-    Vec3 L;
-    std::size_t n;
-    double r_max;
-    std::size_t bins;
-  };
-  for (const Case& c : {Case{Vec3(10, 12, 14), 3000, 3.0, 100}, Case{Vec3(20, 20, 20), 12000, 2.5, 250},
-                        Case{Vec3(9, 9, 30), 2000, 4.5, 64} /* 2 cells on x: fallback */}) {
-    Box box;
-    box.L = c.L;
-    const auto p = uniform_points(c.n, box, rng);
-    std::vector<std::uint64_t> a(c.bins, 0), b(c.bins, 0);
-    pair_histogram_brute(p, box, c.r_max, a);
-    pair_histogram_cells(p, box, c.r_max, b);
-    EXPECT_EQ(a, b);
-    std::uint64_t sum = 0;
-    for (auto x : a) sum += x;
-    EXPECT_GT(sum, c.n);  // something was counted
-  }
-  // Through the observer, including bodies exactly on the box faces.
   Box box;
   box.L = Vec3::Constant(12.0);
   auto p = uniform_points(4000, box, rng);
   p[0] = Vec3(0.0, 0.0, 0.0);
   p[1] = Vec3(11.9999999, 0.0, 6.0);
-  RdfSpec brute, cells;
-  brute.r_max = cells.r_max = 3.9;
-  brute.method = RdfSpec::Method::brute_force;
-  cells.method = RdfSpec::Method::cells;
-  RadialDistribution g1(brute), g2(cells);
+  RdfSpec spec;
+  spec.r_max = 3.9;
+  spec.bins = 200;
+  RadialDistribution g1(spec);
   g1.sample(0.0, state_at(p), box);
-  g2.sample(0.0, state_at(p), box);
-  EXPECT_EQ(g1.pair_counts(), g2.pair_counts());
-  EXPECT_EQ(g1.g(), g2.g());
+  std::vector<std::uint64_t> ref(200, 0);
+  all_pairs_histogram(p, box, 3.9, ref);
+  EXPECT_EQ(g1.pair_counts(), ref);
 }
 
 TEST(RadialDistribution, SimpleCubicLatticeShells) {
