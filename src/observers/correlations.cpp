@@ -6,6 +6,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "core/interrupt.hpp"
+
 namespace hb {
 
 namespace {
@@ -81,6 +83,7 @@ void TimeCorrelations::reset() {
   sum_c2_.assign(m, 0.0);
   sum_fs_.assign(m, 0.0);
   count_.assign(m, 0);
+  pending_.ready = false;
 }
 
 namespace {
@@ -151,55 +154,155 @@ void TimeCorrelations::load(const std::vector<double>& d) {
   first_time_ = d[6];
   n_ = n;
   box_L_ = Vec3(d[8], d[9], d[10]);
+  pending_.ready = false;
 }
 
-void TimeCorrelations::init_q(const Box& box) {
-  box_L_ = box.L;
-  qs_.clear();
-  const Vec3 dq = (2.0 * kPi) * box.L.cwiseInverse();  // spacing of the reciprocal lattice
-  const double target = spec_.q;
-  const double dq_max = dq.maxCoeff();
-  // Every candidate lies within |q| in [target - w, target + w]: the closest achievable modulus
-  // is within dq_max of the target (along the coarsest axis), plus the tolerance shell.
-  const double w = dq_max + 2.0 * spec_.q_tolerance * (target + dq_max);
-  const double qlo = std::max(0.0, target - w), qhi = target + w;
-  struct Cand {
-    Vec3 q;
-    double norm;
-  };
-  std::vector<Cand> cands;
-  const int nx_max = static_cast<int>(std::ceil(qhi / dq.x()));
-  const int ny_max = static_cast<int>(std::ceil(qhi / dq.y()));
+namespace {
+
+// A lattice vector and its key in the selection order.
+struct QCand {
+  double dist;  // | |k| - reference |
+  int nx, ny, nz;
+  Vec3 q;
+};
+bool before(const QCand& a, const QCand& b) {
+  if (a.dist != b.dist) return a.dist < b.dist;
+  if (a.nx != b.nx) return a.nx < b.nx;
+  if (a.ny != b.ny) return a.ny < b.ny;
+  return a.nz < b.nz;
+}
+
+// Calls f(nx, ny, nz, k, |k|) for the lattice vectors (one of each +-k pair) whose modulus may
+// lie in [lo, hi] (a superset: the caller tests |k|), in (nx, ny, nz) order. The loops run over
+// the (nx, ny) columns of the shell and, in each, over the nz of the shell only.
+template <class F>
+void for_lattice_shell(const Vec3& dq, double lo, double hi, F&& f) {
+  lo = std::max(0.0, lo);
+  const int nx_max = static_cast<int>(std::ceil(hi / dq.x()));
   for (int nx = 0; nx <= nx_max; ++nx) {
+    poll_interrupt("F_self q vectors");
+    const double rest_x = hi * hi - sqr(nx * dq.x());
+    if (rest_x < 0.0) break;
+    const int ny_max = static_cast<int>(std::floor(std::sqrt(rest_x) / dq.y())) + 1;
     for (int ny = (nx == 0 ? 0 : -ny_max); ny <= ny_max; ++ny) {
       const double qxy2 = sqr(nx * dq.x()) + sqr(ny * dq.y());
-      if (qxy2 > qhi * qhi) continue;
-      const int nz_hi = static_cast<int>(std::floor(std::sqrt(qhi * qhi - qxy2) / dq.z()));
-      const double rest_lo = qlo * qlo - qxy2;
-      const int nz_lo_abs = rest_lo > 0.0 ? static_cast<int>(std::ceil(std::sqrt(rest_lo) / dq.z())) : 0;
-      for (int nz = -nz_hi; nz <= nz_hi; ++nz) {
-        if (std::abs(nz) < nz_lo_abs) continue;
-        // One of each +-n pair: the first nonzero component positive.
+      if (qxy2 > hi * hi) continue;
+      const int z_hi = static_cast<int>(std::floor(std::sqrt(hi * hi - qxy2) / dq.z())) + 1;
+      const double rest_lo = lo * lo - qxy2;
+      const int z_lo = rest_lo > 0.0 ? std::max(0, static_cast<int>(std::ceil(std::sqrt(rest_lo) / dq.z())) - 1) : 0;
+      for (int nz = -z_hi; nz <= z_hi; ++nz) {
+        if (std::abs(nz) < z_lo) {  // jump over the inside of the shell
+          nz = z_lo - 1;
+          continue;
+        }
         if (nx == 0 && ny == 0 && nz <= 0) continue;
-        if (nx == 0 && ny < 0) continue;
-        const Vec3 q(nx * dq.x(), ny * dq.y(), nz * dq.z());
-        cands.push_back({q, q.norm()});
+        const Vec3 k(nx * dq.x(), ny * dq.y(), nz * dq.z());
+        f(nx, ny, nz, k, k.norm());
       }
     }
   }
-  if (cands.empty()) throw std::invalid_argument("TimeCorrelations: no q vector fits the box");
-  double best = cands.front().norm;
-  for (const auto& c : cands)
-    if (std::abs(c.norm - target) < std::abs(best - target)) best = c.norm;
-  // (1e-12: the same n.n in another order may round differently)
-  const double keep = (spec_.q_tolerance + 1e-12) * best;
-  std::erase_if(cands, [&](const Cand& c) { return std::abs(c.norm - best) > keep; });
-  std::stable_sort(cands.begin(), cands.end(), [&](const Cand& a, const Cand& b) {
-    return std::abs(a.norm - best) < std::abs(b.norm - best);
+}
+
+// Deterministic 64-bit generator (splitmix64) for the random directions.
+std::uint64_t splitmix64(std::uint64_t& s) {
+  std::uint64_t z = (s += 0x9e3779b97f4a7c15ULL);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+double uniform01(std::uint64_t& s) { return double(splitmix64(s) >> 11) * 0x1.0p-53; }
+
+std::vector<Vec3> random_lattice_q(const Vec3& dq, double target, int max_vectors) {
+  std::uint64_t seed = 0x5eedf5e1fULL;
+  std::vector<Eigen::Vector3d> ns;
+  std::vector<Vec3> out;
+  for (long attempt = 0; attempt < 100L * max_vectors && int(out.size()) < max_vectors; ++attempt) {
+    if ((attempt & 0xff) == 0) poll_interrupt("F_self q vectors");
+    const double z = 2.0 * uniform01(seed) - 1.0, phi = 2.0 * kPi * uniform01(seed);
+    const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const Vec3 dir(s * std::cos(phi), s * std::sin(phi), z);
+    Eigen::Vector3d n;
+    for (int d = 0; d < 3; ++d) n[d] = std::round(target * dir[d] / dq[d]);
+    if (n.cwiseAbs().maxCoeff() > 2e9)
+      throw std::invalid_argument("TimeCorrelations: q L is too large for the lattice q vectors");
+    // One of each +-n pair: the first nonzero component positive.
+    for (int d = 0; d < 3; ++d)
+      if (n[d] != 0.0) {
+        if (n[d] < 0.0) n = -n;
+        break;
+      }
+    if (n.isZero() || std::find(ns.begin(), ns.end(), n) != ns.end()) continue;
+    ns.push_back(n);
+    out.push_back(n.cwiseProduct(dq));
+  }
+  return out;
+}
+
+}  // namespace
+
+bool lattice_q_is_random(const Vec3& L, double q, double tolerance) {
+  const Vec3 dq = (2.0 * kPi) * L.cwiseInverse();
+  const double hi = q * (1.0 + tolerance) + dq.maxCoeff();
+  return (hi / dq.x() + 1.0) * (2.0 * hi / dq.y() + 1.0) > kMaxQColumns;
+}
+
+QSelection lattice_q_vectors(const Vec3& L, double target, double tolerance, int max_vectors) {
+  QSelection sel;
+  const Vec3 dq = (2.0 * kPi) * L.cwiseInverse();  // spacing of the reciprocal lattice
+  const std::size_t m = static_cast<std::size_t>(std::max(1, max_vectors));
+  if (lattice_q_is_random(L, target, tolerance)) {
+    sel.random = true;
+    sel.q = random_lattice_q(dq, target, max_vectors);
+    if (sel.q.empty()) throw std::invalid_argument("TimeCorrelations: no q vector fits the box");
+    return sel;
+  }
+  // The closest achievable modulus: the point (round(target / dq_x), 0, 0) is within dq_x / 2,
+  // so it lies in the shell of half-width dq_max; the first in (nx, ny, nz) order on ties.
+  const double dq_max = dq.maxCoeff();
+  double best = -1.0, best_dist = 0.0;
+  for_lattice_shell(dq, target - dq_max, target + dq_max, [&](int, int, int, const Vec3&, double norm) {
+    const double d = std::abs(norm - target);
+    if (best < 0.0 || d < best_dist) {
+      best = norm;
+      best_dist = d;
+    }
   });
-  if (cands.size() > static_cast<std::size_t>(spec_.max_q_vectors))
-    cands.resize(static_cast<std::size_t>(spec_.max_q_vectors));
-  for (const auto& c : cands) qs_.push_back(c.q);
+  if (best < 0.0) throw std::invalid_argument("TimeCorrelations: no q vector fits the box");
+  // (1e-12: the same n.n in another order may round differently)
+  const double keep = (tolerance + 1e-12) * best;
+  // Widen the shell |k| in [best - delta, best + delta] from about 4 max_vectors expected
+  // lattice points (2 pi best^2 x 2 delta / cell volume in the half space) until it holds
+  // max_vectors or reaches the tolerance; keep only the max_vectors first (a bounded heap).
+  const double cell = dq.x() * dq.y() * dq.z();
+  double delta = std::min(keep, std::max(1e-12 * best, double(m) * cell / (kPi * best * best)));
+  std::vector<QCand> heap;
+  for (;;) {
+    heap.clear();
+    std::size_t seen = 0;
+    for_lattice_shell(dq, best - delta, best + delta, [&](int nx, int ny, int nz, const Vec3& k, double norm) {
+      const double d = std::abs(norm - best);
+      if (d > delta) return;
+      ++seen;
+      const QCand c{d, nx, ny, nz, k};
+      if (heap.size() == m && !before(c, heap.front())) return;
+      heap.push_back(c);
+      std::push_heap(heap.begin(), heap.end(), before);
+      if (heap.size() > m) {
+        std::pop_heap(heap.begin(), heap.end(), before);
+        heap.pop_back();
+      }
+    });
+    if (seen >= m || delta >= keep) break;
+    delta = std::min(keep, 2.0 * delta);
+  }
+  std::sort_heap(heap.begin(), heap.end(), before);
+  for (const auto& c : heap) sel.q.push_back(c.q);
+  return sel;
+}
+
+const char* TimeCorrelations::q_selection() const {
+  if (qs_.empty()) return "none";
+  return lattice_q_is_random(box_L_, spec_.q, spec_.q_tolerance) ? "random" : "shell";
 }
 
 double TimeCorrelations::q_used() const {
@@ -210,11 +313,46 @@ double TimeCorrelations::q_used() const {
 }
 
 void TimeCorrelations::sample(double time, const State& state, const Box& box) {
+  prepare(time, state, box);
+  commit();
+}
+
+TimeCorrelations::Term TimeCorrelations::correlate(const std::vector<Vec3>& r0, const std::vector<Vec3>& u0,
+                                                   int j, const std::vector<Vec3>& qs) const {
+  const std::size_t n = r_now_.size();
+  const double inv_n = n > 0 ? 1.0 / double(n) : 0.0;
+  const double inv_nq = qs.empty() ? 0.0 : 1.0 / double(qs.size());
+  double s2 = 0.0, s4 = 0.0, sc1 = 0.0, sc2 = 0.0, sfs = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if ((i & 0xfff) == 0xfff) poll_interrupt("correlations");
+    const Vec3 d = r_now_[i] - r0[i];
+    const double d2 = d.squaredNorm();
+    s2 += d2;
+    s4 += d2 * d2;
+    const double c = u0[i].dot(u_now_[i]);
+    sc1 += c;
+    sc2 += 1.5 * c * c - 0.5;
+    double f = 0.0;
+    for (const Vec3& q : qs) f += std::cos(q.dot(d));
+    sfs += f * inv_nq;
+  }
+  return {j, s2 * inv_n, s4 * inv_n, sc1 * inv_n, sc2 * inv_n, sfs * inv_n};
+}
+
+void TimeCorrelations::prepare(double time, const State& state, const Box& box) {
+  Pending& p = pending_;
+  p.ready = p.first = p.new_q = p.new_origin = false;
+  p.terms.clear();
   const std::size_t n = state.size();
   if (next_sample_ == 0) {
-    first_time_ = time;
-    n_ = n;
-    if (qs_.empty() || box.L != box_L_) init_q(box);
+    p.first = true;
+    p.first_time = time;
+    p.n = n;
+    if (qs_.empty() || box.L != box_L_) {
+      p.new_q = true;
+      p.qs = lattice_q_vectors(box.L, spec_.q, spec_.q_tolerance, spec_.max_q_vectors).q;
+      p.box_L = box.L;
+    }
   } else {
     const double expected = first_time_ + double(next_sample_) * spec_.interval;
     if (std::abs(time - expected) > 1e-6 * spec_.interval)
@@ -222,54 +360,67 @@ void TimeCorrelations::sample(double time, const State& state, const Box& box) {
                                   " is not first + k * interval = " + std::to_string(expected));
     if (n != n_) throw std::invalid_argument("TimeCorrelations::sample: number of bodies changed");
   }
+  const std::vector<Vec3>& qs = p.new_q ? p.qs : qs_;
 
   // Current unwrapped positions and axes (bodies behind `time` are streamed on a copy).
   r_now_.resize(n);
   u_now_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
+    if ((i & 0xffff) == 0xffff) poll_interrupt("correlations");
     const double dt = time - state.t[i];
     const Quat q = dt == 0.0 ? state.q[i] : orientation_at(state.body(i), dt);
     r_now_[i] = state.r[i] + state.v[i] * dt + state.image[i].cast<double>().cwiseProduct(box.L);
     u_now_[i] = q * spec_.body_axis;
   }
 
-  const std::int64_t k = next_sample_++;
-  const std::int64_t ring = static_cast<std::int64_t>(origins_.size());
-  if (k % origin_every_ == 0) {
-    Origin& o = origins_[static_cast<std::size_t>((k / origin_every_) % ring)];
-    o.index = k;
-    o.r = r_now_;
-    o.u = u_now_;
-  }
-
-  const double inv_n = n > 0 ? 1.0 / double(n) : 0.0;
-  const double inv_nq = qs_.empty() ? 0.0 : 1.0 / double(qs_.size());
+  // Live origins at a grid lag; the slot a new origin replaces holds one beyond max_lag.
+  const std::int64_t k = next_sample_;
   for (const Origin& o : origins_) {
     if (o.index < 0) continue;
     const std::int64_t lag = k - o.index;
     if (lag > spec_.max_lag_samples) continue;
     const int j = slot_[static_cast<std::size_t>(lag)];
-    if (j < 0) continue;
-    double s2 = 0.0, s4 = 0.0, sc1 = 0.0, sc2 = 0.0, sfs = 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec3 d = r_now_[i] - o.r[i];
-      const double d2 = d.squaredNorm();
-      s2 += d2;
-      s4 += d2 * d2;
-      const double c = o.u[i].dot(u_now_[i]);
-      sc1 += c;
-      sc2 += 1.5 * c * c - 0.5;
-      double f = 0.0;
-      for (const Vec3& q : qs_) f += std::cos(q.dot(d));
-      sfs += f * inv_nq;
-    }
-    sum_msd_[j] += s2 * inv_n;
-    sum_r4_[j] += s4 * inv_n;
-    sum_c1_[j] += sc1 * inv_n;
-    sum_c2_[j] += sc2 * inv_n;
-    sum_fs_[j] += sfs * inv_n;
+    if (j >= 0) p.terms.push_back(correlate(o.r, o.u, j, qs));
+  }
+  if (k % origin_every_ == 0) {
+    p.new_origin = true;
+    p.slot = static_cast<std::size_t>((k / origin_every_) % static_cast<std::int64_t>(origins_.size()));
+    p.index = k;
+    p.r = r_now_;
+    p.u = u_now_;
+    p.terms.push_back(correlate(p.r, p.u, slot_[0], qs));  // lag 0
+  }
+  p.ready = true;
+}
+
+void TimeCorrelations::commit() noexcept {
+  Pending& p = pending_;
+  if (!p.ready) return;
+  if (p.first) {
+    first_time_ = p.first_time;
+    n_ = p.n;
+  }
+  if (p.new_q) {
+    qs_.swap(p.qs);
+    box_L_ = p.box_L;
+  }
+  if (p.new_origin) {
+    Origin& o = origins_[p.slot];
+    o.index = p.index;
+    o.r.swap(p.r);
+    o.u.swap(p.u);
+  }
+  for (const Term& t : p.terms) {
+    const auto j = static_cast<std::size_t>(t.j);
+    sum_msd_[j] += t.s2;
+    sum_r4_[j] += t.s4;
+    sum_c1_[j] += t.c1;
+    sum_c2_[j] += t.c2;
+    sum_fs_[j] += t.fs;
     ++count_[j];
   }
+  ++next_sample_;
+  p.ready = false;
 }
 
 std::vector<double> TimeCorrelations::ratio(const std::vector<double>& sum) const {
@@ -347,8 +498,8 @@ std::string TimeCorrelations::to_tsv() const {
                 static_cast<long long>(next_sample_), spec_.body_axis.x(), spec_.body_axis.y(),
                 spec_.body_axis.z());
   out += buf;
-  std::snprintf(buf, sizeof buf, "# q=%.10g q_target=%.10g q_vectors=%zu\n", q_used(), spec_.q,
-                qs_.size());
+  std::snprintf(buf, sizeof buf, "# q=%.10g q_target=%.10g q_vectors=%zu q_selection=%s\n", q_used(), spec_.q,
+                qs_.size(), q_selection());
   out += buf;
   const DiffusionFit f = diffusion();
   std::snprintf(buf, sizeof buf,

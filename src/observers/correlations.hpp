@@ -67,8 +67,15 @@ class TimeCorrelations {
   // Record the state at simulated time `time`. Every body must be at `time` (t[i] == time);
   // a body behind is streamed forward here without changing the state. Times must advance by
   // spec.interval between calls (a relative mismatch above 1e-6 throws std::invalid_argument),
-  // and the number of bodies must not change.
+  // and the number of bodies must not change. sample() = prepare() then commit().
   void sample(double time, const State& state, const Box& box);
+  // The two halves of sample(), so that a driver can sample several observers all or nothing:
+  // prepare() does the work (the q vectors at the first sample, the correlations of every live
+  // origin), polls for interrupts and may throw (hb::Interrupted, std::invalid_argument)
+  // without changing the observer; commit() applies the prepared sample and does not throw.
+  // commit() without a pending sample does nothing.
+  void prepare(double time, const State& state, const Box& box);
+  void commit() noexcept;
   // Forget all origins and sums (e.g. at the end of equilibration).
   void reset();
   // Flat serialisation for checkpoints (exact doubles; includes the live origins, so about
@@ -83,6 +90,8 @@ class TimeCorrelations {
   // q vectors of F_self (set at the first sample from the box) and their mean modulus.
   const std::vector<Vec3>& q_vectors() const { return qs_; }
   double q_used() const;
+  // "shell" (the closest lattice shells, see lattice_q_vectors) or "random" (huge q L).
+  const char* q_selection() const;
 
   // Per-lag results, index matching lags(); NaN where no origin has reached that lag.
   std::vector<double> times() const;
@@ -106,7 +115,12 @@ class TimeCorrelations {
     std::vector<Vec3> r;     // unwrapped positions
     std::vector<Vec3> u;     // lab-frame body axis
   };
-  void init_q(const Box& box);
+  struct Term {  // one origin's contribution to lag slot j
+    int j;
+    double s2, s4, c1, c2, fs;
+  };
+  Term correlate(const std::vector<Vec3>& r0, const std::vector<Vec3>& u0, int j,
+                 const std::vector<Vec3>& qs) const;
   std::vector<double> ratio(const std::vector<double>& sum) const;
 
   CorrelationSpec spec_;
@@ -123,7 +137,40 @@ class TimeCorrelations {
   std::vector<double> sum_msd_, sum_r4_, sum_c1_, sum_c2_, sum_fs_;
   std::vector<std::int64_t> count_;
   std::vector<Vec3> r_now_, u_now_;  // scratch
+  struct Pending {
+    bool ready = false;
+    bool first = false;      // the first sample: sets first_time_, n_ (and the q vectors)
+    double first_time = 0.0;
+    std::size_t n = 0;
+    bool new_q = false;
+    std::vector<Vec3> qs;
+    Vec3 box_L = Vec3::Zero();
+    bool new_origin = false;
+    std::size_t slot = 0;
+    std::int64_t index = 0;
+    std::vector<Vec3> r, u;  // the new origin (swapped into the ring by commit)
+    std::vector<Term> terms;
+  } pending_;
 };
+
+// The q vectors of F_self for a box of edges L: lattice vectors k = 2 pi (n_x / L_x, n_y / L_y,
+// n_z / L_z), one of each +-k pair (first nonzero component of n positive). Shell selection:
+// the achievable modulus closest to `q` (first in (n_x, n_y, n_z) order on ties), then the
+// vectors whose modulus is within `tolerance` (relative) of it, closest first (ties in
+// (n_x, n_y, n_z) order), at most `max_vectors`. The shells are enumerated directly (the
+// (n_x, n_y) columns of the shell, widened until max_vectors are found), so the time is
+// O((q L)^2) and the memory O(max_vectors). When the shell has more than
+// kMaxQColumns (n_x, n_y) columns the vectors are instead the lattice points nearest to
+// max_vectors directions drawn with a fixed seed (each within sqrt(3)/2 of a lattice spacing of
+// |q|; `tolerance` is not used). Polls for interrupts. Throws std::invalid_argument when no
+// vector fits (q L too large for int indices).
+constexpr double kMaxQColumns = 1e7;
+struct QSelection {
+  std::vector<Vec3> q;
+  bool random = false;
+};
+QSelection lattice_q_vectors(const Vec3& L, double q, double tolerance, int max_vectors);
+bool lattice_q_is_random(const Vec3& L, double q, double tolerance);
 
 // Analytic C2(t) = < P2(u(0).u(t)) > of a free spherical top (moment of inertia I, constant
 // angular velocity) with Maxwell-distributed angular velocity, <w_k^2> = kT/I per component,
