@@ -246,9 +246,16 @@ def pool(c: Campaign, rows: list[dict]) -> list[dict]:
     return out
 
 
+def plot_axes(c: Campaign) -> tuple[str, list[str]]:
+    """The x key of the plots and the keys whose values make separate series (the other varied
+    keys, except those zipped with x: they move with it)."""
+    x = c.plot_x or c.keys[0]
+    return x, [k for k in c.keys if k != x and not (x in c.zipped and k in c.zipped)]
+
+
 def plot(c: Campaign, rows: list[dict], pooled: list[dict]) -> list[Path]:
     """OUT/<key>.png per collected key: the key against the x grid key (plot.x, or the first
-    varied key), one series per value of the other varied keys; filled symbols are the mean
+    varied key), one series per value of the other varied keys (not those zipped with x); filled symbols are the mean
     over seeds with its standard error over seeds, small open symbols each run with its own
     block error."""
     if not c.keys:
@@ -257,8 +264,7 @@ def plot(c: Campaign, rows: list[dict], pooled: list[dict]) -> list[Path]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    x = c.plot_x or c.keys[0]
-    others = [k for k in c.keys if k != x]
+    x, others = plot_axes(c)
     xs = sorted({json.dumps(r[x]) for r in rows}, key=lambda t: (not _number(json.loads(t)), json.loads(t) if _number(json.loads(t)) else t))
     numeric = all(_number(json.loads(t)) for t in xs)
     pos = (lambda v: v) if numeric else (lambda v: xs.index(json.dumps(v)))

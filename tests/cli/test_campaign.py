@@ -201,3 +201,16 @@ def test_missing_campaign_file_exits_2(tmp_path):
     assert r.returncode == 2 and "is a directory" in r.stderr, r.stderr
     r = campaign([], tmp_path)
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1 and "give a campaign file" in r.stderr, r.stderr
+
+
+def test_plot_series_ignore_keys_zipped_with_x(tmp_path):
+    """The equation-of-state campaign zips run.time with phi: one series, not one per phi."""
+    import hardbody_campaign as hc
+    c = hc.load(EXAMPLE / "eos-ellipsoids.toml")
+    assert hc.plot_axes(c) == ("system.packing_fraction", [])
+    assert len(c.runs) == 30 and c.runs[0].name == "packing_fraction=0.05,time=500.0,seed=1"
+    shutil.copy(EXAMPLE / "spheres-small-base.toml", tmp_path / "base.toml")
+    (tmp_path / "g.toml").write_text('base = "base.toml"\n[grid]\n"neighbors.method" = ["cells", "nnl"]\n'
+                                     '[zip]\n"system.packing_fraction" = [0.1, 0.2]\n"run.time" = [2.0, 1.0]\n'
+                                     '[plot]\nx = "system.packing_fraction"\n')
+    assert hc.plot_axes(hc.load(tmp_path / "g.toml")) == ("system.packing_fraction", ["neighbors.method"])
