@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "geometry/perram_wertheim.hpp"
+#include "neighbors/cell_list.hpp"
 #include "observers/close_pairs.hpp"
 
 namespace hb {
@@ -30,9 +31,11 @@ OverlapReport sphere_overlaps_brute(const std::vector<Vec3>& r, const Box& box, 
 void for_close_pairs(const std::vector<Vec3>& r, const Box& box, double range,
                      const std::function<void(std::uint32_t, std::uint32_t, const Vec3&)>& fn) {
   int nc[3];
-  bool brute = false;
+  bool brute = box.L.minCoeff() < 3.0 * range;
+  // cells no wider than needed, but at most 64 per body (phi = 1e-9 asked for ~1e11 cells)
+  const double w = brute ? range : capped_cell_width(box.L, range, r.size());
   for (int k = 0; k < 3; ++k) {
-    nc[k] = static_cast<int>(std::floor(box.L[k] / range));
+    nc[k] = static_cast<int>(std::floor(box.L[k] / w));
     if (nc[k] < 3) brute = true;
   }
   const double r2 = range * range;

@@ -114,16 +114,13 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 SMALL = ["--set", "run.time=0.05", "--set", "run.equilibrate_time=0.02", "--set", "output.log_interval=0.025"]
 
 
-# The other shapes' start is checked for overlaps by for_close_pairs (src/observers/overlap.cpp),
-# whose own cell grid still asks for ~1e11 cells: it needs capped_cell_width (cell_list.hpp) too.
-NEEDS_OVERLAP_GRID_CAP = pytest.mark.xfail(strict=True, reason="for_close_pairs grid not capped yet")
-
-
+# The other shapes' start is also checked for overlaps by for_close_pairs
+# (src/observers/overlap.cpp), whose own cell grid is capped the same way.
 @pytest.mark.parametrize("example,particles", [
     ("hard-spheres", 108),
-    pytest.param("ellipsoids", 64, marks=NEEDS_OVERLAP_GRID_CAP),
-    pytest.param("superquadrics", 64, marks=NEEDS_OVERLAP_GRID_CAP),
-    pytest.param("binary-spheres", None, marks=NEEDS_OVERLAP_GRID_CAP)])
+    ("ellipsoids", 64),
+    ("superquadrics", 64),
+    ("binary-spheres", None)])
 def test_a_dilute_box_runs(tmp_path, example, particles):
     """phi = 1e-9: the cell grid once asked for ~1e11 cells (std::bad_alloc, exit 3)."""
     args = ["--set", "system.packing_fraction=1e-9", *SMALL]
