@@ -20,7 +20,10 @@ test: build build-debug
 	cd build-asan && ctest -L unit -j $(JOBS) --output-on-failure
 	cd build && ctest -j $(JOBS) --output-on-failure
 
-example: build
+# the example needs only the program (not the tests, benchmarks or the Python module)
+example: deps
+	cmake -S . -B build -DCMAKE_BUILD_TYPE=Release $(CMAKE_ARGS) >/dev/null
+	cmake --build build -j $(JOBS) --target hardbody
 	./build/apps/hardbody/hardbody run examples/hard-spheres.toml --out run-hard-spheres --overwrite
 
 bench: build

@@ -195,7 +195,7 @@ TOML
     # results identical to the local executor's (scripts/test-slurm-campaign.sh; ~5 minutes)
     HB="$HB" exec scripts/test-slurm-campaign.sh ;;
   tables) ;;
-  *) echo "unknown group '$group' (ellipsoids, ellipsoids-045, superquadrics, sq-taus, sq-vs-ellipsoid, tables)" >&2
+  *) echo "unknown group '$group' (ellipsoids, ellipsoids-045, superquadrics, sq-taus, sq-vs-ellipsoid, tops, slurm, tables)" >&2
      exit 2 ;;
 esac
 

@@ -67,6 +67,7 @@ int main(int argc, char** argv) {
   auto* cmd_campaign = app.add_subcommand("campaign", "run or inspect a campaign of many runs (docs/campaigns.md)");
   cmd_campaign->allow_extras();
   cmd_campaign->prefix_command();
+  cmd_campaign->set_help_flag();  // `hardbody campaign --help` is the driver's own help
 
   try {
     app.parse(argc, argv);

@@ -52,6 +52,8 @@ const std::vector<KeySpec>& key_specs() {
       {"output", "max_output_gb", Kind::Float, "limit on the files of a run (trajectory, logs, tables, checkpoint; estimated from the config before the start, in 1e9 bytes): a run that would write more is refused"},
       {"init", "method", Kind::String, "\"auto\" (default): \"lattice\" for one species of equal spheres, \"grow\" otherwise; \"grow\": Lubachevsky-Stillinger growth from a dilute placement at init.phi0; \"lattice\": (stretched) lattice at the target; mixtures always grow from a random placement"},
       {"init", "phi0", Kind::Float, "packing fraction of the dilute start that is grown"},
+      {"init", "file", Kind::String, "init.method = \"file\": a GSD file (a hardbody trajectory or checkpoint, or any HOOMD-schema file) whose frame holds the start: N, species, box and packing fraction must match the config; velocities and spins as in the file"},
+      {"init", "frame", Kind::Int, "init.method = \"file\": the frame of init.file (0 = first; default: the last)"},
       {"init", "growth_rate", Kind::Float, "d(scale)/dt of the growth (scale 1 = target size)"},
       {"observables", "interval", Kind::Float, "sampling interval of MSD, C2, F_self (0: off)"},
       {"observables", "origin_every", Kind::Int, "a new time origin every this many samples"},
@@ -486,6 +488,8 @@ Config validate(const std::string& file, const toml::table& root) {
   r.real("output", "max_output_gb", c.max_output_gb);
   r.string("init", "method", c.init_method);
   r.real("init", "phi0", c.init_phi0);
+  r.string("init", "file", c.init_file);
+  r.integer("init", "frame", c.init_frame);
   r.real("init", "growth_rate", c.init_growth_rate);
   r.real("observables", "interval", c.obs_interval);
   r.integer("observables", "origin_every", c.obs_origin_every);
@@ -564,8 +568,12 @@ Config validate(const std::string& file, const toml::table& root) {
   if (!(c.snapshot_interval > 0.0)) bad("output", "snapshot_interval", "must be positive");
   if (!(c.checkpoint_interval > 0.0)) bad("output", "checkpoint_interval", "must be positive");
   if (!(c.max_output_gb > 0.0)) bad("output", "max_output_gb", "must be positive");
-  if (c.init_method != "auto" && c.init_method != "grow" && c.init_method != "lattice")
-    bad("init", "method", fmt::format("must be \"auto\", \"grow\" or \"lattice\" (got \"{}\")", c.init_method));
+  if (c.init_method != "auto" && c.init_method != "grow" && c.init_method != "lattice" && c.init_method != "file")
+    bad("init", "method", fmt::format("must be \"auto\", \"grow\", \"lattice\" or \"file\" (got \"{}\")", c.init_method));
+  if (c.init_method == "file" && c.init_file.empty())
+    bad("init", "file", "init.method = \"file\" needs init.file (a GSD file)");
+  if (c.init_method != "file" && !c.init_file.empty())
+    bad("init", "file", fmt::format("is read only with init.method = \"file\" (init.method is \"{}\")", c.init_method));
   // "auto": one species of equal spheres starts on the FCC lattice at the target; everything else
   // grows (config.resolved.toml records the method used)
   if (c.init_method == "auto")
@@ -748,6 +756,10 @@ std::string to_toml(const Config& c) {
   init.insert("method", c.init_method);
   init.insert("phi0", c.init_phi0);
   init.insert("growth_rate", c.init_growth_rate);
+  if (c.init_method == "file") {
+    init.insert("file", c.init_file);
+    if (c.init_frame != kLastFrame) init.insert("frame", static_cast<std::int64_t>(c.init_frame));
+  }
   root.insert("init", init);
   return "# hardbody resolved configuration (every key, defaults filled in)\n" + toml_text(root);
 }

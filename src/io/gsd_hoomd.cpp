@@ -1,6 +1,8 @@
 // HOOMD-schema frames over the GSD file layer; see gsd_hoomd.hpp for the rules.
 #include "io/gsd_hoomd.hpp"
 
+#include "core/fault_injection.hpp"
+
 #include <unistd.h>
 #include <fcntl.h>
 
@@ -536,6 +538,7 @@ void write_atomic(const std::filesystem::path& path, const Frame& frame, std::si
     HoomdWriter w = HoomdWriter::create(tmp);
     if (buffer_size > 0) w.set_buffer_size(buffer_size);
     w.write_frame(frame);
+    fault_point("checkpoint-write");  // tests: a kill here must leave the previous file usable
     w.sync();
     w.close();
     std::error_code ec;

@@ -10,9 +10,11 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <limits>
 #include <optional>
 #include <sstream>
 
+#include "core/fault_injection.hpp"
 #include "core/interrupt.hpp"
 #include "io/checkpoint.hpp"
 #include "io/config.hpp"
@@ -83,16 +85,18 @@ class LogTable {
       }
     }
     write_file_atomic(part_, kept);
-    out_.open(part_, std::ios::app);
-    if (!out_) throw InputError(fmt::format("{}: cannot write", part_));
+    try {
+      out_ = AppendFile(part_);
+    } catch (const std::runtime_error& e) {
+      throw InputError(e.what());
+    }
   }
   template <class... T>
   void row(const T&... v) {
     std::string s;
     ((s += fmt::format("{:.10g}\t", v)), ...);
     s.back() = '\n';
-    out_ << s;
-    out_.flush();
+    out_.write(s);  // every write checked (a full disk throws, naming the file)
   }
   void commit() {
     out_.close();
@@ -101,7 +105,7 @@ class LogTable {
 
  private:
   std::string path_, part_;
-  std::ofstream out_;
+  AppendFile out_;
 };
 
 // The bodies of species a (same order), for the per-species correlations of a mixture.
@@ -136,6 +140,12 @@ void truncate_trajectory(const std::string& path, std::uint64_t frames) {
   }
   std::filesystem::rename(tmp, path);
 }
+
+// The state became non-finite: a run-time failure whose checkpoint is the previous one.
+class NonFiniteState : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 // Has the measured run reached its end (run.time or run.max_collisions)?
 template <class Sim>
@@ -219,6 +229,9 @@ class Driver {
     auto measured_cpu = [&] { return st_.cpu_prev + (st_.phase == 1 ? cpu_seconds() - cpu_mark_ : 0.0); };
     if (st_.phase == 1) cpu_mark_ = cpu0;
 
+    // the first checkpoint at once: a run stopped in its first checkpoint interval (600 wall
+    // seconds by default) still resumes, and the growth is not repeated
+    if (!opt_.resume) write_checkpoint();
     std::uint64_t steps = 0;
     while (st_.phase < 2) {
       if (st_.phase == 0 && sim_.now() >= t_eq) {
@@ -266,11 +279,12 @@ class Driver {
         }
         if ((++steps & 4095) == 0) housekeeping();
       }
+      if (sim_.now() >= block_end || limit) check_finite();  // each log block (and equilibration end)
       if (st_.phase == 1 && (sim_.now() >= block_end || limit)) {
         const double kT = temperature();
         pressure_.close_block(sim_.now() - st_.block_start, kT, n);
         st_.block_start = sim_.now();
-        nem_.sample(sim_.now(), synchronized_state(sim_), sim_.box());
+        if (!all_spheres()) nem_.sample(sim_.now() - t_eq, synchronized_state(sim_), sim_.box());
         temps_.sample(species_temperatures(synchronized_state(sim_)));
         log.row(sim_.now() - t_eq, double(sim_.collisions()) - st_.coll0, pressure_.last_Z(),
                 pressure_.Z().mean, kT, (energy() - st_.e0) / st_.e0,
@@ -295,7 +309,8 @@ class Driver {
                                          : std::max(sim_.now() / t_end,
                                                     cfg_.max_collisions ? (double(sim_.collisions()) - st_.coll0) / cfg_.max_collisions : 0.0);
       if (!opt_.quiet)
-        progress_.update(st_.phase == 0 ? "equilibrate" : "measure", sim_.now(), sim_.collisions(),
+        // time as in log.tsv: measured time (from 0) once measuring, simulated time before
+        progress_.update(st_.phase == 0 ? "equilibrate" : "measure", st_.phase == 0 ? sim_.now() : sim_.now() - t_eq, sim_.collisions(),
                          st_.phase == 0 ? 0.0 : pressure_.Z().mean, std::min(frac, 1.0));
     }
     if (!opt_.quiet) progress_.finish();
@@ -305,7 +320,32 @@ class Driver {
   }
 
   // Checkpoint of the current moment (also used on failures).
+  // A state that is not finite (a solver or integration failure nothing else caught) ends the run
+  // with exit 3, naming the first such body with its state (a reproducer of its motion); it is
+  // never written over the previous checkpoint.
+  void check_finite() const {
+    try {
+      fault_point("nonfinite");  // tests: HARDBODY_FAULT=nonfinite:FAIL:N stands for a damaged state
+    } catch (const std::runtime_error& e) {
+      throw NonFiniteState(fmt::format("{}: a non-finite state (injected)", e.what()));
+    }
+    const State& s = sim_.state();
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      if (s.r[i].allFinite() && s.v[i].allFinite() && s.w[i].allFinite() && s.q[i].coeffs().allFinite() &&
+          std::isfinite(s.t[i]))
+        continue;
+      throw NonFiniteState(fmt::format(
+          "body {} has a non-finite state at t = {:.17g}: position [{:.17g}, {:.17g}, {:.17g}], "
+          "orientation [{:.17g}, {:.17g}, {:.17g}, {:.17g}], velocity [{:.17g}, {:.17g}, {:.17g}], "
+          "angular velocity [{:.17g}, {:.17g}, {:.17g}], time stamp {:.17g}", i, sim_.now(),
+          s.r[i].x(), s.r[i].y(), s.r[i].z(), s.q[i].w(), s.q[i].x(), s.q[i].y(), s.q[i].z(),
+          s.v[i].x(), s.v[i].y(), s.v[i].z(), s.w[i].x(), s.w[i].y(), s.w[i].z(), s.t[i]));
+    }
+  }
+
   void write_checkpoint() {
+    fault_point("checkpoint");
+    check_finite();  // a damaged state never replaces the last good checkpoint
     st_.pressure = pressure_.save();
     st_.corr = corr_.save();
     st_.gr = rdf_.save();
@@ -332,20 +372,31 @@ class Driver {
     const bool gr = cfg_.gr_interval > 0.0 && sim_.now() >= st_.next_gr;
     if (!corr && !gr) return;
     const State s = synchronized_state(sim_);
+    // Every due observer prepares its sample (the work; a stop request may interrupt it and
+    // change nothing), then all commit (no throw): a checkpoint never holds half a sample.
     if (corr) {
-      corr_.sample(sim_.now(), s, sim_.box());
+      corr_.prepare(sim_.now(), s, sim_.box());
       for (std::size_t a = 0; a < corr_species_.size(); ++a)
-        corr_species_[a].sample(sim_.now(), species_subset(s, a), sim_.box());
+        corr_species_[a].prepare(sim_.now(), species_subset(s, a), sim_.box());
+    }
+    if (gr) {
+      rdf_.prepare(sim_.now(), s, sim_.box());
+      if (partial_gr()) gr_partial_.prepare(sim_.now(), s, sim_.box(), rdf_.r_max_for(sim_.box(), s.size()));
+    }
+    if (corr) {
+      corr_.commit();
+      for (auto& c : corr_species_) c.commit();
       st_.next_corr += cfg_.obs_interval;
     }
     if (gr) {
-      rdf_.sample(sim_.now(), s, sim_.box());
-      if (partial_gr()) gr_partial_.sample(sim_.now(), s, sim_.box(), rdf_.r_max());
+      rdf_.commit();
+      if (partial_gr()) gr_partial_.commit();
       st_.next_gr += cfg_.gr_interval;
     }
   }
 
   void housekeeping() {
+    fault_point(st_.phase == 0 ? "equilibrate" : "measure");
     poll_interrupt();
     if (progress_.wall_seconds() - last_checkpoint_ >= cfg_.checkpoint_interval) write_checkpoint();
   }
@@ -357,6 +408,11 @@ class Driver {
     return t_end - t <= 1e-9 * cfg_.log_interval ? t_end : t;
   }
   bool partial_gr() const { return cfg_.species.size() > 1; }
+  bool all_spheres() const {
+    for (const Species& sp : cfg_.species)
+      if (!std::holds_alternative<Sphere>(sp.shape)) return false;
+    return true;
+  }
   double energy() const { return ops_.kinetic(sim_.state()); }
   // translational temperature 2 K_trans / (3 N)
   double temperature() const { return ops_.temperature(sim_.state()); }
@@ -431,6 +487,7 @@ class Driver {
   }
 
   void finish(LogTable& log) {
+    fault_point("final");
     const State st = synchronized_state(sim_);
     const std::uint64_t n = st.size();
     const double e1 = ops_.kinetic(st);
@@ -463,8 +520,23 @@ class Driver {
     j["Z_blocks"] = Z.blocks;
     j["collision_rate"] = rate.mean;
     j["collision_rate_error"] = rate.error;
-    j["temperature"] = ops_.temperature(st);
     species_summary(j, st, pressure_.measured_time());
+    // The temperature of the measured stretch: the time average of the translational temperature
+    // (one sample per log block; mixtures: the count-weighted mean of the species' averages, its
+    // error combining theirs as independent); the instantaneous one of the final state beside it.
+    {
+      double t = 0.0, e2 = 0.0;
+      for (const auto& sp : j["species"]) {
+        const double w = double(sp["count"].get<std::size_t>()) / double(n);
+        t += w * sp["temperature_translational"].get<double>();
+        const auto& err = sp["temperature_translational_error"];
+        e2 = err.is_number() && std::isfinite(e2) ? e2 + w * w * std::pow(err.get<double>(), 2)
+                                                 : std::numeric_limits<double>::quiet_NaN();
+      }
+      j["temperature"] = t;
+      j["temperature_error"] = std::sqrt(e2);  // NaN -> null: fewer than 2 log blocks
+      j["temperature_final"] = ops_.temperature(st);
+    }
     j["energy_drift"] = (e1 - st_.e0) / st_.e0;
     j["total_momentum"] = {p.x(), p.y(), p.z()};
     j["momentum_drift"] = p.norm() / p_scale;
@@ -522,7 +594,7 @@ class Driver {
       for (const Species& sp : cfg_.species) names.push_back(sp.name);
       write_file_atomic(dir_ + "/gr_partial.tsv", gr_partial_.to_tsv(names));
     }
-    write_file_atomic(dir_ + "/nematic.tsv", nem_.to_tsv());
+    if (!all_spheres()) write_file_atomic(dir_ + "/nematic.tsv", nem_.to_tsv());  // spheres: S2 = 1
     if (!Z.error_known())
       j["notes"].push_back(fmt::format(
           "Z_error, collision_rate_error and the temperature errors are null (unknown): the "
@@ -530,6 +602,7 @@ class Driver {
           "output.log_interval >= 2)", Z.blocks));
     for (const auto& [k, v] : extra_.items()) j[k] = v;
     log.commit();
+    fault_point("summary");
     write_file_atomic(dir_ + "/summary.json", j.dump(2) + "\n");
     if (!opt_.quiet)
       std::fprintf(stderr, "hardbody: %s: t=%.6g collisions=%llu Z=%.5f +- %s overlaps=%llu -> %s\n",
@@ -562,6 +635,20 @@ class Driver {
   double snapshot_min_gap_ = kInf;
 };
 
+// Writes the checkpoint of a stopping run and says what happened to it (a failed write, e.g. a
+// full disk, leaves the previous checkpoint as it was: files are written to a temporary name and
+// renamed).
+template <class D>
+std::string checkpoint_outcome(D& d, const std::string& dir, const std::string& failure = "") {
+  try {
+    d.write_checkpoint();
+    return fmt::format("checkpoint written to {}/checkpoint.gsd", dir);
+  } catch (const std::exception& w) {
+    const std::string why = w.what() == failure ? std::string("the same error") : std::string(w.what());
+    return fmt::format("checkpoint NOT written: {}; the previous checkpoint in {} is intact", why, dir);
+  }
+}
+
 template <class Sim>
 void drive(const Config& cfg, const RunOptions& opt, const std::string& dir, Sim& sim,
            const DriverState& st, const SystemOps& ops, nlohmann::json extra) {
@@ -569,37 +656,118 @@ void drive(const Config& cfg, const RunOptions& opt, const std::string& dir, Sim
   try {
     d.run();
   } catch (const Interrupted& e) {
-    d.write_checkpoint();
-    throw RunInterrupted(fmt::format(
-        "interrupted by signal {}; checkpoint written to {}/checkpoint.gsd (continue with --resume)",
-        e.signal, dir), e.signal);
+    throw RunInterrupted(fmt::format("interrupted by signal {}; {} (continue with --resume)", e.signal,
+                                     checkpoint_outcome(d, dir)), e.signal);
   } catch (const ConfigError&) {
     throw;
   } catch (const InputError&) {
     throw;
-  } catch (const RunFailure& e) {
-    try {
-      d.write_checkpoint();
-    } catch (...) {
-    }
-    throw;
+  } catch (const NonFiniteState& e) {
+    throw RunFailure(fmt::format("{} (checkpoint NOT written: the previous checkpoint in {} is intact)",
+                                 e.what(), dir));
   } catch (const std::exception& e) {
-    try {
-      d.write_checkpoint();
-    } catch (...) {
-    }
-    throw RunFailure(fmt::format("{} (checkpoint written to {}/checkpoint.gsd)", e.what(), dir));
+    throw RunFailure(fmt::format("{} ({})", e.what(), checkpoint_outcome(d, dir, e.what())));
   }
 }
 
 // summary.json "init": how the initial bodies were made.
 nlohmann::json init_json(const StartInfo& i) {
-  if (i.method != "grow") return {{"method", i.method}};
-  const GrowthResult& g = i.result;
-  return {{"method", "grow"}, {"phi0", i.growth.phi0}, {"growth_rate", i.growth.rate},
-          {"growth_time", g.time}, {"growth_collisions", g.collisions},
-          {"growth_wall_seconds", g.wall_seconds}, {"growth_velocity_rescales", g.rescales},
-          {"min_distance_after_growth", g.overlaps.min_distance}};
+  nlohmann::json j;
+  if (i.method != "grow") {
+    j = {{"method", i.method}};
+  } else {
+    const GrowthResult& g = i.result;
+    j = {{"method", "grow"}, {"placement", i.placement}, {"phi0", i.growth.phi0},
+         {"growth_rate", i.growth.rate}, {"growth_time", g.time}, {"growth_collisions", g.collisions},
+         {"growth_wall_seconds", g.wall_seconds}, {"growth_velocity_rescales", g.rescales},
+         {"min_distance_after_growth", g.overlaps.min_distance}};
+  }
+  if (!i.note.empty()) j["note"] = i.note;
+  return j;
+}
+
+// init.method = "file": the bodies of a GSD frame, which must be the config's system (N, species
+// counts, packing fraction); positions, orientations, velocities and spins as in the file.
+Start start_from_file(const Config& cfg) {
+  Start s;
+  const long frame = cfg.init_frame == kLastFrame ? -1L : static_cast<long>(cfg.init_frame);
+  s.state = state_from_gsd(cfg.init_file, frame, s.box);  // InputError naming the file
+  const std::string where = fmt::format("{}: key 'init.file': {}", cfg.source, cfg.init_file);
+  if (s.state.size() != cfg.particles)
+    throw InputError(fmt::format("{} holds {} bodies, the config {}", where, s.state.size(), cfg.particles));
+  std::vector<std::uint64_t> count(cfg.species.size(), 0);
+  for (std::size_t i = 0; i < s.state.size(); ++i) {
+    if (s.state.species[i] >= cfg.species.size())
+      throw InputError(fmt::format("{}: body {} has type id {}, the config has {} species", where, i,
+                                   s.state.species[i], cfg.species.size()));
+    ++count[s.state.species[i]];
+  }
+  for (std::size_t a = 0; a < cfg.species.size(); ++a)
+    if (count[a] != cfg.species[a].count)
+      throw InputError(fmt::format("{} holds {} bodies of species {} ('{}'), the config {}", where, count[a], a,
+                                   cfg.species[a].name, cfg.species[a].count));
+  const double phi = body_volume(cfg.species, s.state) / s.box.volume();
+  if (!(std::abs(phi - cfg.packing_fraction) <= 1e-9 * cfg.packing_fraction))
+    throw InputError(fmt::format("{}: its packing fraction is {:.17g}, system.packing_fraction is {}; set "
+                                 "system.packing_fraction = {:.17g}", where, phi, cfg.packing_fraction, phi));
+  s.info.method = "file";
+  s.info.note = fmt::format("{} frame {}", cfg.init_file, frame < 0 ? std::string("last") : std::to_string(frame));
+  return s;
+}
+
+// The assembly's start (a lattice, or a growth with a progress line and the jam test). A jammed
+// growth is bad input (exit 2: the target cannot be reached); a stop request during it exits
+// 128 + signal (the growth has no checkpoint: --resume starts it again).
+template <class A>
+Start make_start(const Config& cfg, const RunOptions& opt, const std::string& dir, const A& as) {
+  Progress progress;
+  StartOptions so{opt.quiet, {}};
+  GrowthStatus last;
+  bool grew = false;
+  auto show = [&](const GrowthStatus& g, bool force) {
+    progress.update_text("grow", fmt::format("t={:.4g} phi={:.5f} -> {:.5g} free path={:.3g}", g.time, g.phi,
+                                             cfg.packing_fraction, g.free_path),
+                         g.collisions, g.fraction, force);
+  };
+  if (!opt.quiet)
+    so.growth_report = [&](const GrowthStatus& g) {
+      last = g, grew = true;
+      show(g, false);
+    };
+  auto done = [&] {  // the last growth line is always shown
+    if (opt.quiet) return;
+    if (grew) show(last, true);
+    progress.finish();
+  };
+  if (cfg.init_method == "file") return start_from_file(cfg);
+  try {
+    Start s = as.start(so);
+    done();
+    return s;
+  } catch (const GrowthJammed& e) {
+    done();
+    throw InputError(fmt::format("{}: key 'system.packing_fraction': {} cannot be reached: {}; ask for a "
+                                 "lower packing fraction, or grow more slowly (init.growth_rate)",
+                                 cfg.source, cfg.packing_fraction, e.what()));
+  } catch (const GrowthFailed& e) {
+    done();
+    // no checkpoint exists in the growth: the bodies at the failure go to a frame for inspection
+    std::string saved;
+    try {
+      gsd::write_frame_atomic(dir + "/growth-failure.gsd",
+                              ckpt::frame_source(e.state, e.box, e.time, 0, cfg.species));
+      saved = fmt::format("the bodies at the failure are in {}/growth-failure.gsd", dir);
+    } catch (const std::exception& w) {
+      saved = fmt::format("the bodies at the failure could not be written ({})", w.what());
+    }
+    throw RunFailure(fmt::format("{}; {} (the growth has no checkpoint: --resume starts it again)",
+                                 e.what(), saved));
+  } catch (const Interrupted& e) {
+    done();
+    throw RunInterrupted(fmt::format("interrupted by signal {} during the start (growth); no checkpoint "
+                                     "exists yet: --resume starts the run again in {}", e.signal, dir),
+                         e.signal);
+  }
 }
 
 // Starts a new run from the assembly's start, or resumes from the checkpoint (a finished run is
@@ -608,7 +776,24 @@ template <class A>
 void start_or_resume_in(const Config& cfg, const RunOptions& opt, const std::string& dir, const A& as) {
   if (opt.resume) {
     const std::string ck = dir + "/checkpoint.gsd";
-    if (!file_exists(ck)) throw InputError(fmt::format("{}: no checkpoint to resume from", ck));
+    if (!file_exists(ck)) {
+      const std::string marker = dir + "/config.resolved.toml";
+      if (!file_exists(marker)) throw InputError(fmt::format("{}: no checkpoint to resume from", ck));
+      // stopped before its first checkpoint (during the start): start again with the same config
+      std::ostringstream text;
+      text << std::ifstream(marker).rdbuf();
+      if (text.str() != to_toml(cfg))
+        throw InputError(fmt::format("{}: the run stopped before its first checkpoint with another "
+                                     "config ({}); start it again with --overwrite", dir, marker));
+      if (!opt.quiet)
+        std::fprintf(stderr, "hardbody: %s: no checkpoint yet (stopped during the start); starting again\n", dir.c_str());
+      std::error_code ec;
+      std::filesystem::remove(dir + "/growth-failure.gsd", ec);  // of the failed start, if any
+      RunOptions fresh = opt;
+      fresh.resume = false;
+      start_or_resume_in(cfg, fresh, dir, as);
+      return;
+    }
     auto r = read_checkpoint<typename A::neighbors_type>(ck, cfg);
     auto sim = as.restore(r.box, std::move(r.state), r.neighbors, r.loop);
     check_restored(sim, as.ops(), ck);
@@ -628,12 +813,16 @@ void start_or_resume_in(const Config& cfg, const RunOptions& opt, const std::str
                    dir.c_str(), t_ck, t_ck);
       return;
     }
-    const bool grown = cfg.mixture() || (!std::holds_alternative<Sphere>(cfg.one().shape) &&
-                                         cfg.init_method == "grow" && cfg.packing_fraction > cfg.init_phi0);
-    drive(cfg, opt, dir, sim, r.driver, as.ops(), {{"init", {{"method", grown ? "grow" : "lattice"}}}});
+    const bool grown = cfg.mixture() || (cfg.init_method == "grow" && cfg.packing_fraction > cfg.init_phi0);
+    const char* method = cfg.init_method == "file" ? "file" : grown ? "grow" : "lattice";
+    drive(cfg, opt, dir, sim, r.driver, as.ops(), {{"init", {{"method", method}}}});
     return;
   }
-  Start start = as.start(StartOptions{opt.quiet});
+  // config.resolved.toml marks the directory as this run's before the start is made: a run
+  // stopped during its growth (no checkpoint yet) is resumed by starting again (the start is a
+  // function of the config).
+  write_file_atomic(dir + "/config.resolved.toml", to_toml(cfg));
+  Start start = make_start(cfg, opt, dir, as);
   auto sim = as.simulate(start.box, std::move(start.state));
   {
     const auto rep = as.ops().overlaps(sim.state(), sim.box());
@@ -641,7 +830,6 @@ void start_or_resume_in(const Config& cfg, const RunOptions& opt, const std::str
       throw InputError(fmt::format("{}: the initial configuration has {} overlapping pairs",
                                    cfg.source, rep.overlaps));
   }
-  write_file_atomic(dir + "/config.resolved.toml", to_toml(cfg));
   drive(cfg, opt, dir, sim, DriverState{}, as.ops(), {{"init", init_json(start.info)}});
 }
 
@@ -649,16 +837,29 @@ template <class A>
 void start_or_resume(const Config& cfg, const RunOptions& opt, const std::string& dir, const A& as) {
   const SignalGuard guard;
   RunDirectory rd(dir, opt.resume, opt.overwrite);  // checked and locked before any work
+  // Bad input found before the first checkpoint leaves nothing behind (the marker written before
+  // the start included).
+  auto discard = [&] {
+    std::error_code ec;
+    if (!opt.resume && !file_exists(dir + "/checkpoint.gsd"))
+      std::filesystem::remove(dir + "/config.resolved.toml", ec);
+    rd.discard_if_unused();
+  };
   try {
     start_or_resume_in(cfg, opt, dir, as);
+    // a stop request that arrived during the final outputs: they are complete, but the caller
+    // asked to stop and hears so (a campaign's --resume then finds the run finished)
+    if (const int sig = pending_signal())
+      throw RunInterrupted(fmt::format("interrupted by signal {} as the run finished; its outputs in {} are "
+                                       "complete (--resume has nothing to do)", sig, dir), sig);
   } catch (const InputError&) {
-    rd.discard_if_unused();
+    discard();
     throw;
   } catch (const ConfigError&) {
-    rd.discard_if_unused();
+    discard();
     throw;
   } catch (const std::invalid_argument&) {
-    rd.discard_if_unused();
+    discard();
     throw;
   }
 }

@@ -15,7 +15,8 @@ SphereSystemSpec plan_spheres(const Config& c) {
   p.shell = c.neighbors_method == "nnl" ? c.shell : 0.0;
   const Box box = cubic_box_for(c.particles, volume(c.one().shape), c.packing_fraction);
   const double phi_max = fcc_max_packing_fraction(c.particles);
-  if (c.packing_fraction > phi_max * (1.0 - 1e-12))
+  const bool grow = c.init_method == "grow" && c.packing_fraction > c.init_phi0;  // random start
+  if (!grow && c.packing_fraction > phi_max * (1.0 - 1e-12))
     throw ConfigError(fmt::format(
         "{}: key 'system.packing_fraction': {} is too dense for an FCC start with {} particles "
         "(at most {:.4f}; use N = 4 m^3 for up to 0.74)",
@@ -90,12 +91,25 @@ RigidSystemSpec plan_rigid(const Config& c) {
   const double a0 = lattice_constant(c.particles, c.packing_fraction, lat.m, unit);
   const Vec3 L(p.semi_axes.x() * a0 * lat.m[0], p.semi_axes.y() * a0 * lat.m[1],
                p.semi_axes.z() * a0 * lat.m[2]);
-  const double range = 2.0 * bounding_radius(sp.shape);
-  if (L.minCoeff() < 2.0 * range)
-    throw ConfigError(fmt::format(
-        "{}: key 'system.particles': {} particles at packing fraction {} give a box side of "
-        "{:.3g}, less than two body lengths ({:.3g}); use more particles",
-        c.source, c.particles, c.packing_fraction, L.minCoeff(), 2.0 * range));
+  const double range = 2.0 * bounding_radius(sp.shape);  // the body length
+  if (L.minCoeff() < 2.0 * range) {
+    // The lattice of aligned bodies stretches the box along the long axis; a growth can start in a
+    // cubic box instead (random placement), whose side is limited by the minimum image only.
+    const double Lc = std::cbrt(double(c.particles) * volume(sp.shape) / c.packing_fraction);
+    const double n_min = std::ceil(std::pow(2.0 * range, 3) * c.packing_fraction / volume(sp.shape));
+    if (Lc < 2.0 * range)
+      throw ConfigError(fmt::format(
+          "{}: key 'system.particles': {} bodies at packing fraction {} fill a cubic box of side "
+          "{:.3g}, less than two body lengths ({:.3g}, the minimum image); use at least {} bodies",
+          c.source, c.particles, c.packing_fraction, Lc, 2.0 * range, n_min));
+    if (c.init_method != "grow")
+      throw ConfigError(fmt::format(
+          "{}: key 'init.method': the lattice start of {} bodies at packing fraction {} is a box of "
+          "sides {:.3g} x {:.3g} x {:.3g}, thinner than two body lengths ({:.3g}); \"grow\" starts in "
+          "a cubic box of side {:.3g}", c.source, c.particles, c.packing_fraction, L.x(), L.y(), L.z(),
+          2.0 * range, Lc));
+    p.cubic_start = true;
+  }
   return p;
 }
 

@@ -81,6 +81,8 @@ inline std::vector<double> species_masses(const SpeciesTable& t) {
 // How the initial bodies were made (summary.json "init").
 struct StartInfo {
   std::string method = "lattice";  // "lattice" | "grow"
+  std::string placement;           // method "grow": "lattice" (dilute lattice) | "random"
+  std::string note;                // why the start differs from what was asked (or empty)
   GrowthOptions growth;            // method "grow"
   GrowthResult result;             // method "grow" (its state moved out)
 };
@@ -91,6 +93,7 @@ struct Start {
 };
 struct StartOptions {
   bool quiet = true;  // false: one line on stderr before a growth
+  std::function<void(const GrowthStatus&)> growth_report;  // progress of a growth (may be empty)
 };
 
 // The geometry checks (ConfigError naming the key) and the specifications of the starts.
@@ -137,6 +140,7 @@ inline Start grown_start(GrowthResult result, const GrowthOptions& go, const Ove
                          std::uint64_t seed) {
   Start s;
   s.info.method = "grow";
+  s.info.placement = "random";
   s.info.growth = go;
   s.info.result = std::move(result);
   s.info.result.overlaps = check(s.info.result.state, s.info.result.box);
@@ -166,7 +170,9 @@ void assemble_spheres(const Config& c, F&& f) {
                   check = ops.overlaps](const StartOptions& opt) {
       if (!opt.quiet)
         std::fprintf(stderr, "hardbody: placing at phi = %g, growing to %g (rate %g) ...\n", go.phi0, phi, go.rate);
-      return grown_start(grow_sphere_mixture(species, phi, seed, go), go, check, seed);
+      GrowthOptions g = go;
+      g.report = opt.growth_report;
+      return grown_start(grow_sphere_mixture(species, phi, seed, g), go, check, seed);
     };
     f(Assembly<HardSphereMixture, CellNeighbors>(model, CellNeighbors(model.interaction_range()), ops, start));
     return;
@@ -175,7 +181,21 @@ void assemble_spheres(const Config& c, F&& f) {
   const SphereSystemSpec spec = plan_spheres(c);
   SystemOps ops{species_masses(c.species), [m = spec.mass](const State& s) { return kinetic_energy(s, m); },
                 independent_overlap_check(c.one().shape)};
-  auto start = [spec](const StartOptions&) {
+  // init.method = "grow": random placement at init.phi0 grown to the target (a fluid start
+  // for metastable states); otherwise the FCC lattice at the target
+  const bool grow = c.init_method == "grow" && c.packing_fraction > c.init_phi0;
+  GrowthOptions go;
+  go.rate = c.init_growth_rate;
+  go.phi0 = c.init_phi0;
+  go.kT = c.temperature;
+  auto start = [spec, grow, go, species = c.species, check = ops.overlaps](const StartOptions& opt) {
+    if (grow) {
+      if (!opt.quiet)
+        std::fprintf(stderr, "hardbody: placing at phi = %g, growing to %g (rate %g) ...\n", go.phi0, spec.phi, go.rate);
+      GrowthOptions g = go;
+      g.report = opt.growth_report;
+      return grown_start(grow_sphere_mixture(species, spec.phi, spec.seed, g), go, check, spec.seed);
+    }
     Start s;
     s.state = hard_sphere_start(spec, s.box);
     return s;
@@ -206,17 +226,34 @@ void assemble_rigid(const Config& c, const S& shape, F&& f) {
   go.rate = c.init_growth_rate;
   go.phi0 = c.init_phi0;
   go.kT = c.temperature;
-  auto start = [=, check = ops.overlaps](const StartOptions& opt) {
+  auto start = [=, species = c.species, check = ops.overlaps](const StartOptions& opt) {
+    if (spec.cubic_start) {  // the stretched lattice would be too thin: random placement, cubic box
+      if (!opt.quiet)
+        std::fprintf(stderr, "hardbody: placing at phi <= %g in a cubic box, growing to %g (rate %g) ...\n",
+                     std::min(go.phi0, spec.phi), spec.phi, go.rate);
+      GrowthOptions g = go;
+      g.phi0 = std::min(go.phi0, spec.phi);
+      g.report = opt.growth_report;
+      return grown_start(grow_rigid_mixture(species, spec.phi, spec.seed, g, spec.eps_d), g, check, spec.seed);
+    }
     Start s;
     if (!grow) {
       s.state = lattice(spec, s.box);
+      if (c.init_method == "grow") {
+        s.info.note = fmt::format("init.method = \"grow\" but system.packing_fraction = {} is not above "
+                                  "init.phi0 = {}: started on the lattice at the target", spec.phi, go.phi0);
+        if (!opt.quiet) std::fprintf(stderr, "hardbody: note: %s\n", s.info.note.c_str());
+      }
       return s;
     }
+    GrowthOptions g = go;
+    g.report = opt.growth_report;
     if (!opt.quiet)
       std::fprintf(stderr, "hardbody: growing from phi = %g to %g (rate %g) ...\n", go.phi0, spec.phi, go.rate);
     s.info.method = "grow";
+    s.info.placement = "lattice";
     s.info.growth = go;
-    s.info.result = grow_lattice(shape, spec, go, lattice, check);
+    s.info.result = grow_lattice(shape, spec, g, lattice, check);
     s.box = s.info.result.box;
     s.state = std::move(s.info.result.state);
     return s;
@@ -243,7 +280,9 @@ void assemble_rigid_mixture(const Config& c, F&& f) {
                 check = ops.overlaps](const StartOptions& opt) {
     if (!opt.quiet)
       std::fprintf(stderr, "hardbody: placing at phi <= %g, growing to %g (rate %g) ...\n", go.phi0, phi, go.rate);
-    return grown_start(grow_rigid_mixture(species, phi, seed, go, eps_d), go, check, seed);
+    GrowthOptions g = go;
+    g.report = opt.growth_report;
+    return grown_start(grow_rigid_mixture(species, phi, seed, g, eps_d), go, check, seed);
   };
   if (c.neighbors_method == "nnl")
     f(Assembly<RigidMixture, ObbNeighbors<AnyShape>>(

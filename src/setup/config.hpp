@@ -18,6 +18,8 @@ class ConfigError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+inline constexpr std::uint64_t kLastFrame = ~std::uint64_t(0);
+
 struct Config {
   std::string source;  // file the config was read from
   // [system]
@@ -52,6 +54,8 @@ struct Config {
   std::string init_method = "auto";  // "grow" (Lubachevsky–Stillinger from init.phi0) | "lattice"
                                      // ("auto" is resolved by load_config)
   double init_phi0 = 0.1;            // packing fraction of the dilute lattice that is grown
+  std::string init_file;             // init.method = "file": the GSD file of the start
+  std::uint64_t init_frame = kLastFrame;  // its frame (kLastFrame: the last)
   double init_growth_rate = 0.05;    // d(scale)/dt of the growth
   // [observables]
   double obs_interval = 0.1;     // sampling interval of MSD, C2, F_self (0: off)

@@ -133,7 +133,9 @@ GrowthResult grow_sphere_mixture(const SpeciesTable& species, double phi, std::u
     for (auto& v : x.v) v *= f;
     return k - model.kinetic_energy(x);
   };
-  GrowthResult res = s0 < 1.0 ? run_growth(model, std::move(st), box, opt, thermostat) : GrowthResult{};
+  GrowthOptions o = opt;
+  o.phi_target = phi;
+  GrowthResult res = s0 < 1.0 ? run_growth(model, std::move(st), box, o, thermostat) : GrowthResult{};
   if (s0 >= 1.0) res.state = std::move(st), res.box = box, res.s0 = 1.0;
   res.phi = body_volume(species, res.state) / box.volume();
   return res;
@@ -167,13 +169,9 @@ void random_orientations(State& s, std::uint64_t seed) {
 }
 
 double rescale_to_temperature(State& s, const RigidMixture& model, double kT) {
-  double kt = 0.0, kr = 0.0;
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    const MassProperties m = model.body_mass(s, i);
-    kt += 0.5 * m.mass * s.v[i].squaredNorm();
-    kr += 0.5 * s.w[i].dot(m.apply_inertia(s.q[i], s.w[i]));
-  }
-  return scale_to_temperature(s, kt, kr, kT);
+  return thermalize_per_dof(
+      s, kT, [&](std::size_t i) { return model.body_mass(s, i).mass; },
+      [&](std::size_t i) { return Vec3(model.body_mass(s, i).inertia_body.diagonal()); });
 }
 
 GrowthResult grow_rigid_mixture(const SpeciesTable& species, double phi, std::uint64_t seed,
@@ -202,7 +200,9 @@ GrowthResult grow_rigid_mixture(const SpeciesTable& species, double phi, std::ui
   maxwell_boltzmann_spin(st, opt.kT, inertia, seed);
   GrowthResult res;
   if (s0 < 1.0) {
-    res = run_growth(model, std::move(st), box, opt,
+    GrowthOptions o = opt;
+    o.phi_target = phi;
+    res = run_growth(model, std::move(st), box, o,
                      [&](State& x) { return rescale_to_temperature(x, model, opt.kT); });
   } else {
     res.state = std::move(st), res.box = box, res.s0 = 1.0;

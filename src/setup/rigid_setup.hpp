@@ -38,6 +38,8 @@ struct RigidSystemSpec {
   std::uint64_t seed = 1;
   double eps_d = 1e-5;
   Vec3 exponents = Vec3(2.0, 2.0, 2.0);  // superquadrics only
+  bool cubic_start = false;  // builder: grow from a random placement in a cubic box (the stretched
+                             // lattice of N bodies would be thinner than two body lengths)
 };
 
 using EllipsoidCellSim = Simulation<RigidBodies<Ellipsoid>, CellNeighbors>;

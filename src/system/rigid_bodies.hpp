@@ -86,16 +86,28 @@ struct CollisionContact {
   Vec3 r_ab;
   DistanceResult d;
 };
-template <class Dist>
+// shapes() gives the JSON of both shapes as solved (at the growth scale): the failure message
+// carries a `hardbody distance` reproducer.
+template <class Dist, class Shapes>
 CollisionContact collision_contact(const BodyState& a, const BodyState& b, const Box& box,
-                                   std::uint32_t i, std::uint32_t j, SolverStats& stats, Dist&& dist) {
+                                   std::uint32_t i, std::uint32_t j, SolverStats& stats, Dist&& dist,
+                                   Shapes&& shapes) {
   CollisionContact c;
   c.r_ab = box.near_image(b.r - a.r);
   const Pose pa{a.r, a.q.toRotationMatrix()};
   const Pose pb{Vec3(a.r + c.r_ab), b.q.toRotationMatrix()};
   c.d = dist(pa, pb);
-  if (c.d.status == DistanceStatus::failed)
-    throw SolverFailure(fmt::format("distance solver failed at the collision of {} and {}", i, j));
+  if (c.d.status == DistanceStatus::failed) {
+    const auto [ja, jb] = shapes();
+    auto body = [](const std::string& shape, const Vec3& r, const Quat& q) {
+      return fmt::format("{{\"shape\": {}, \"position\": [{:.17g}, {:.17g}, {:.17g}], \"orientation\": "
+                         "[{:.17g}, {:.17g}, {:.17g}, {:.17g}]}}",
+                         shape, r.x(), r.y(), r.z(), q.w(), q.x(), q.y(), q.z());
+    };
+    throw SolverFailure(fmt::format(
+        "distance solver failed at the collision of {} and {}; reproducer (hardbody distance): "
+        "{{\"a\": {}, \"b\": {}}}", i, j, body(ja, a.r, a.q), body(jb, pb.r, b.q)));
+  }
   if (c.d.status == DistanceStatus::fallback) ++stats.collision_distance_fallbacks;
   return c;
 }
@@ -212,11 +224,17 @@ struct RigidBodies {
                           double now) const {
     BodyState a = s.body(i), b = s.body(j);  // both at `now`
     const double sc = law.scale_at(now), sdot = law.rate_at(now);
-    const auto [r_ab, d] = collision_contact(a, b, box, i, j, stats, [&](const Pose& pa, const Pose& pb) {
-      if (sc == 1.0) return distance(shape, pa, shape, pb, options.distance);
-      const auto shp = scaled_shape(shape, sc);
-      return distance(shp, pa, shp, pb, options.distance);
-    });
+    const auto [r_ab, d] = collision_contact(
+        a, b, box, i, j, stats,
+        [&](const Pose& pa, const Pose& pb) {
+          if (sc == 1.0) return distance(shape, pa, shape, pb, options.distance);
+          const auto shp = scaled_shape(shape, sc);
+          return distance(shp, pa, shp, pb, options.distance);
+        },
+        [&] {
+          const std::string js = hb::shape_json(AnyShape(resized(shape, sc)));
+          return std::pair{js, js};
+        });
     const double grow = growth_normal_speed(sc, sdot, d.normal, r_ab);
     const double L = shape.bounding_radius() * sc;
     const double rate = (b.v - a.v).norm() + (a.w.norm() + b.w.norm()) * L + 2.0 * sdot / sc * L;

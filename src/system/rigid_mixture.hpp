@@ -118,14 +118,19 @@ struct RigidMixture {
     BodyState a = s.body(i), b = s.body(j);  // both at `now`
     const double sc = law.scale_at(now), sdot = law.rate_at(now);
     const AnyShape sa = body_shape(s, i), sb = body_shape(s, j);
-    const auto [r_ab, d] = collision_contact(a, b, box, i, j, stats, [&](const Pose& pa, const Pose& pb) {
-      return std::visit(
-          [&](const auto& A, const auto& B) {
-            if (sc == 1.0) return distance(A, pa, B, pb, options.distance);
-            return distance(resized(A, sc), pa, resized(B, sc), pb, options.distance);
-          },
-          sa, sb);
-    });
+    const auto [r_ab, d] = collision_contact(
+        a, b, box, i, j, stats,
+        [&](const Pose& pa, const Pose& pb) {
+          return std::visit(
+              [&](const auto& A, const auto& B) {
+                if (sc == 1.0) return distance(A, pa, B, pb, options.distance);
+                return distance(resized(A, sc), pa, resized(B, sc), pb, options.distance);
+              },
+              sa, sb);
+        },
+        [&] {
+          return std::pair{shape_json(resized(sa, sc)), shape_json(resized(sb, sc))};
+        });
     const double grow = growth_normal_speed(sc, sdot, d.normal, r_ab);
     const double La = bounding_radius(sa) * sc, Lb = bounding_radius(sb) * sc;
     const double rate = (b.v - a.v).norm() + a.w.norm() * La + b.w.norm() * Lb +
