@@ -8,36 +8,15 @@
 
 #include "io/config.hpp"
 #include "shapes/codec.hpp"
+#include "config_test_util.hpp"
 
 using namespace hb;
 
 namespace {
-const char* kGood = R"(
-[system]
-particles = 256
-packing_fraction = 0.3
-seed = 7
-[shape]
-type = "sphere"
-radius = 0.5
-[run]
-equilibrate_time = 1.0
-time = 2.0
-)";
-
-std::string error_of(const std::string& text, const std::vector<std::string>& ov = {}) {
-  try {
-    parse_config(text, "cfg.toml", ov);
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "";
-}
-std::string replace(std::string s, const std::string& a, const std::string& b) {
-  const auto p = s.find(a);
-  EXPECT_NE(p, std::string::npos) << a;
-  return s.replace(p, a.size(), b);
-}
+using testing_config::error_of;
+using testing_config::replace;
+// the shared config one line down: the line numbers asserted below count from here
+const std::string kGood = std::string("\n") + testing_config::kGoodSpheres;
 }  // namespace
 
 TEST(Config, GoodConfigParsesWithDefaults) {

@@ -13,22 +13,14 @@
 #include "io/resources.hpp"
 #include "neighbors/cell_list.hpp"
 #include "shapes/codec.hpp"
+#include "config_test_util.hpp"
 
 using namespace hb;
 
 namespace {
 
-const char* kGood = R"([system]
-particles = 256
-packing_fraction = 0.3
-seed = 7
-[shape]
-type = "sphere"
-radius = 0.5
-[run]
-equilibrate_time = 1.0
-time = 2.0
-)";
+using testing_config::error_of;
+const char* const kGood = testing_config::kGoodSpheres;
 
 const char* kMixture = R"([system]
 packing_fraction = 0.35
@@ -47,15 +39,6 @@ shape = { type = "sphere", radius = 0.3 }
 [run]
 time = 0.1
 )";
-
-std::string error_of(const std::string& text, const std::vector<std::string>& ov = {}) {
-  try {
-    parse_config(text, "cfg.toml", ov);
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 bool has(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
