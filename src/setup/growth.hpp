@@ -122,11 +122,11 @@ struct GrowthOptions {
   // the default 1e-4 is a reduced pressure ~ 3e3: far beyond any equilibrium state the growth
   // could be asked for (Z < 100 up to close packing of the crystal), and reached only when the
   // bodies are jammed: phi then rises by less than ~1e-3 before the gaps close (ellipsoids X0 = 2
-  // grown at rate 0.05 towards 0.75: the test fires at phi = 0.6935; a tenfold smaller threshold
-  // reaches 0.6999 at 3x the cost).
+  // grown at rate 0.05 towards 0.75: the test fires at phi = 0.6928; a tenfold smaller threshold
+  // reaches 0.6999 at 4x the cost).
   double jam_free_path = 1e-4;
-  // Called every few thousand events (not thread-safe; may be empty). Signals are polled at the
-  // same points (core/interrupt.hpp): an interrupted growth throws hb::Interrupted.
+  // Called every 1024 events (not thread-safe; may be empty). Signals are polled at the same
+  // points (core/interrupt.hpp): an interrupted growth throws hb::Interrupted.
   std::function<void(const GrowthStatus&)> report;
 };
 
@@ -136,6 +136,19 @@ class GrowthJammed : public std::runtime_error {
   GrowthJammed(const std::string& what, double phi) : std::runtime_error(what), phi(phi) {}
   double phi;
 };
+
+// A growth stopped by a run-time failure (a solver failure: its message carries the reproducer):
+// the bodies at that moment (each at its own time stamp `state.t`), for inspection.
+class GrowthFailed : public std::runtime_error {
+ public:
+  GrowthFailed(const std::string& what, State state, Box box, double time)
+      : std::runtime_error(what), state(std::move(state)), box(box), time(time) {}
+  State state;
+  Box box;
+  double time;
+};
+
+inline constexpr double kJamWindow = 25.0;  // collisions per body in a jam-test window
 
 struct GrowthResult {
   State state;  // synchronized; time stamps reset to 0 (the start of the continuing run)
@@ -157,19 +170,6 @@ struct GrowthResult {
 // returns the kinetic energy removed), then continues with a fresh prediction. The state's time
 // stamps are taken as the start time 0; the result holds the synchronized state at t_stop, time
 // stamps reset to 0 (no overlap check here).
-// A growth stopped by a run-time failure (a solver failure: its message carries the reproducer):
-// the bodies at that moment (each at its own time stamp `state.t`), for inspection.
-class GrowthFailed : public std::runtime_error {
- public:
-  GrowthFailed(const std::string& what, State state, Box box, double time)
-      : std::runtime_error(what), state(std::move(state)), box(box), time(time) {}
-  State state;
-  Box box;
-  double time;
-};
-
-inline constexpr double kJamWindow = 25.0;  // collisions per body in a jam-test window
-
 template <class Model, class Rescale>
 GrowthResult run_growth(Model model, State st, const Box& box, const GrowthOptions& opt,
                         Rescale rescale) {
