@@ -57,40 +57,63 @@ namespace hb {
 // conserved; the heat of the growth goes into the five other degrees of freedom, a common
 // rescaling drains the decoupled one (~0.5 kT at phi = 0.4) and leaves the others hot (T_trans
 // 1.02-1.10 after the growth). Smooth spheres in a mixture likewise keep their spin: their three
-// axes are rescaled on their own. A degree of freedom with zero energy stays zero.
-// mass(i) and moments(i) (body-frame principal moments) are the body's at its current scale.
-// Returns the kinetic energy removed.
+// axes are rescaled on their own. A degree of freedom with no energy (zero, or below 1e-20 of its
+// species' kinetic energy: the rounding left by rotating a zero body-frame component to the lab
+// frame and back) is left alone, not blown up to kT. Different factors per species would give the
+// system a net momentum, so each species of two or more bodies first has its own centre-of-mass
+// velocity removed (a lone body of a species keeps its velocity; the total momentum is then
+// removed from all at the end). mass(i) and moments(i) (body-frame principal moments) are the
+// body's at its current scale. Returns the kinetic energy removed.
 template <class Mass, class Moments>
 double thermalize_per_dof(State& s, double kT, Mass&& mass, Moments&& moments) {
   std::size_t groups = 1;
   for (std::size_t i = 0; i < s.size(); ++i) groups = std::max<std::size_t>(groups, s.species[i] + 1);
   // per group: translational energy, rotational energy per axis, body count
-  std::vector<double> kt(groups, 0.0), n(groups, 0.0);
-  std::vector<Vec3> kr(groups, Vec3::Zero());
+  std::vector<double> kt(groups, 0.0), n(groups, 0.0), m(groups, 0.0);
+  std::vector<Vec3> kr(groups, Vec3::Zero()), p(groups, Vec3::Zero());
   double before = 0.0;
   for (std::size_t i = 0; i < s.size(); ++i) {
     const std::size_t g = s.species[i];
     const Vec3 W = s.q[i].conjugate() * s.w[i];  // body frame
-    const Vec3 I = moments(i);
-    kt[g] += 0.5 * mass(i) * s.v[i].squaredNorm();
-    kr[g] += 0.5 * I.cwiseProduct(W.cwiseProduct(W));
+    const double mi = mass(i);
+    before += 0.5 * mi * s.v[i].squaredNorm() + 0.5 * W.dot(moments(i).cwiseProduct(W));
+    kr[g] += 0.5 * moments(i).cwiseProduct(W.cwiseProduct(W));
+    p[g] += mi * s.v[i];
+    m[g] += mi;
     n[g] += 1.0;
+  }
+  bool lone = false;  // a species of one body keeps its momentum
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const std::size_t g = s.species[i];
+    if (n[g] >= 2.0) s.v[i] -= p[g] / m[g];
+    else lone = lone || n[g] == 1.0;
+    kt[g] += 0.5 * mass(i) * s.v[i].squaredNorm();
   }
   std::vector<double> ft(groups, 1.0);
   std::vector<Vec3> fr(groups, Vec3::Ones());
-  double after = 0.0;
   for (std::size_t g = 0; g < groups; ++g) {
-    before += kt[g] + kr[g].sum();
     const double t3 = 1.5 * n[g] * kT, t1 = 0.5 * n[g] * kT;
-    if (kt[g] > 0.0) ft[g] = std::sqrt(t3 / kt[g]), after += t3;
+    const double floor = 1e-20 * (kt[g] + kr[g].sum());
+    if (kt[g] > floor) ft[g] = std::sqrt(t3 / kt[g]);
     for (int k = 0; k < 3; ++k)
-      if (kr[g][k] > 0.0) fr[g][k] = std::sqrt(t1 / kr[g][k]), after += t1;
+      if (kr[g][k] > floor) fr[g][k] = std::sqrt(t1 / kr[g][k]);
   }
+  Vec3 ptot = Vec3::Zero();
+  double mtot = 0.0;
   for (std::size_t i = 0; i < s.size(); ++i) {
     const std::size_t g = s.species[i];
     s.v[i] *= ft[g];
     const Vec3 W = s.q[i].conjugate() * s.w[i];
     s.w[i] = s.q[i] * Vec3(W.cwiseProduct(fr[g]));
+    ptot += mass(i) * s.v[i];
+    mtot += mass(i);
+  }
+  if (lone && mtot > 0.0)
+    for (auto& v : s.v) v -= ptot / mtot;
+  double after = 0.0;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const Vec3 W = s.q[i].conjugate() * s.w[i];
+    after += 0.5 * mass(i) * s.v[i].squaredNorm() + 0.5 * W.dot(moments(i).cwiseProduct(W));
   }
   return before - after;
 }

@@ -240,6 +240,17 @@ TEST(Growth, ThermalizePerDofMatchesTheDefinition) {
     EXPECT_NEAR(kr.y(), 0.5 * na * kT, 1e-12 * na);
     EXPECT_NEAR(kr.z(), g == 1 ? 0.0 : 0.5 * na * kT, 1e-12 * na);
   }
+  // per-species factors must not give the system a net momentum (the input had one)
+  Vec3 p = Vec3::Zero();
+  for (std::size_t i = 0; i < s.size(); ++i) p += masses[s.species[i]] * s.v[i];
+  EXPECT_LT(p.norm(), 1e-12) << "net momentum after the per-species rescaling";
+  // a species of one body keeps its own velocity direction; the total momentum is still removed
+  s.species[7] = 2;
+  thermalize_per_dof(s, kT, [&](std::size_t i) { return s.species[i] == 2 ? 3.0 : masses[s.species[i]]; },
+                     [&](std::size_t i) { return moments[s.species[i] % 2]; });
+  p = Vec3::Zero();
+  for (std::size_t i = 0; i < s.size(); ++i) p += (s.species[i] == 2 ? 3.0 : masses[s.species[i]]) * s.v[i];
+  EXPECT_LT(p.norm(), 1e-12) << "net momentum with a lone-body species";
 }
 TEST(Growth, GrowToOblateX0_05) { grow_case(Vec3(0.5, 1.0, 1.0), "X0=0.5"); }
 
