@@ -10,8 +10,8 @@
 #include "io/config.hpp"
 #include "observers/overlap.hpp"
 #include "observers/thermo.hpp"
-#include "system/box.hpp"
-#include "system/state.hpp"
+#include "core/box.hpp"
+#include "core/state.hpp"
 
 namespace hb::python {
 

@@ -15,9 +15,9 @@
 #include "io/gsd_hoomd.hpp"
 #include "io/run.hpp"
 #include "neighbors/obb_neighbors.hpp"
-#include "system/box.hpp"
+#include "core/box.hpp"
 #include "system/simulation.hpp"
-#include "system/state.hpp"
+#include "core/state.hpp"
 
 namespace hb {
 

@@ -4,8 +4,8 @@
 #pragma once
 #include "events/event.hpp"
 #include "neighbors/cell_list.hpp"
-#include "system/box.hpp"
-#include "system/state.hpp"
+#include "core/box.hpp"
+#include "core/state.hpp"
 
 namespace hb {
 

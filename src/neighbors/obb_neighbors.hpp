@@ -52,8 +52,8 @@
 #include "neighbors/shell_neighbors.hpp"
 #include "shapes/registry.hpp"
 #include "shapes/shape.hpp"
-#include "system/box.hpp"
-#include "system/state.hpp"
+#include "core/box.hpp"
+#include "core/state.hpp"
 
 namespace hb {
 

@@ -8,7 +8,7 @@
 
 #include "math/types.hpp"
 #include <functional>
-#include "system/box.hpp"
+#include "core/box.hpp"
 
 namespace hb {
 

@@ -17,7 +17,7 @@
 #include "observers/overlap.hpp"
 #include "observers/overlap_sampling.hpp"
 #include "shapes/registry.hpp"
-#include "system/state.hpp"
+#include "core/state.hpp"
 
 namespace hb {
 

@@ -45,7 +45,7 @@
 #include "observers/overlap.hpp"
 #include "shapes/shape.hpp"
 #include "shapes/superquadric.hpp"
-#include "system/box.hpp"
+#include "core/box.hpp"
 
 namespace hb {
 

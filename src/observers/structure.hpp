@@ -12,8 +12,8 @@
 #include "core/species.hpp"
 #include "math/types.hpp"
 #include "observers/block_average.hpp"
-#include "system/box.hpp"
-#include "system/state.hpp"
+#include "core/box.hpp"
+#include "core/state.hpp"
 
 namespace hb {
 

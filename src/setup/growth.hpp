@@ -41,11 +41,11 @@
 #include "geometry/distance.hpp"
 #include "neighbors/cell_neighbors.hpp"
 #include "observers/overlap.hpp"
-#include "system/box.hpp"
+#include "core/box.hpp"
 #include "system/rigid_bodies.hpp"
 #include "setup/rigid_setup.hpp"
 #include "system/simulation.hpp"
-#include "system/state.hpp"
+#include "core/state.hpp"
 
 namespace hb {
 

@@ -4,8 +4,8 @@
 #include <vector>
 
 #include "math/types.hpp"
-#include "system/box.hpp"
-#include "system/state.hpp"
+#include "core/box.hpp"
+#include "core/state.hpp"
 
 namespace hb {
 

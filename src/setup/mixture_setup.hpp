@@ -8,10 +8,10 @@
 
 #include "core/species.hpp"
 #include "setup/growth.hpp"
-#include "system/box.hpp"
+#include "core/box.hpp"
 #include "system/hard_sphere_mixture.hpp"
 #include "system/rigid_mixture.hpp"
-#include "system/state.hpp"
+#include "core/state.hpp"
 
 namespace hb {
 

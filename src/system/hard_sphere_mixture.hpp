@@ -23,8 +23,8 @@
 #include "collision/sphere.hpp"
 #include "core/species.hpp"
 #include "motion/growth_law.hpp"
-#include "system/box.hpp"
-#include "system/state.hpp"
+#include "core/box.hpp"
+#include "core/state.hpp"
 
 namespace hb {
 

@@ -2,8 +2,8 @@
 #pragma once
 #include "collision/sphere.hpp"
 #include "contact/hard_sphere_time.hpp"
-#include "system/box.hpp"
-#include "system/state.hpp"
+#include "core/box.hpp"
+#include "core/state.hpp"
 
 namespace hb {
 

@@ -19,8 +19,8 @@
 #include "geometry/distance.hpp"
 #include "motion/growth_law.hpp"
 #include "shapes/codec.hpp"
-#include "system/box.hpp"
-#include "system/state.hpp"
+#include "core/box.hpp"
+#include "core/state.hpp"
 
 namespace hb {
 

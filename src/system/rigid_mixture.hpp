@@ -31,9 +31,9 @@
 #include "motion/growth_law.hpp"
 #include "shapes/codec.hpp"
 #include "shapes/registry.hpp"
-#include "system/box.hpp"
+#include "core/box.hpp"
 #include "system/rigid_bodies.hpp"
-#include "system/state.hpp"
+#include "core/state.hpp"
 
 namespace hb {
 

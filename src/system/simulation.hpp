@@ -31,8 +31,8 @@
 #include "collision/record.hpp"
 #include "events/event.hpp"
 #include "events/queue.hpp"
-#include "system/box.hpp"
-#include "system/state.hpp"
+#include "core/box.hpp"
+#include "core/state.hpp"
 
 namespace hb {
 

@@ -7,7 +7,7 @@
 #include <set>
 
 #include "neighbors/cell_list.hpp"
-#include "system/box.hpp"
+#include "core/box.hpp"
 
 using namespace hb;
 

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "math/types.hpp"
-#include "system/box.hpp"
+#include "core/box.hpp"
 
 namespace hb::test {
 
