@@ -11,6 +11,9 @@ PNG figures next to them:
     gr.tsv (or structure.tsv)    -> gr.png      g(r)
     gr_partial.tsv (mixtures)    -> gr_partial.png  g_ab(r) of every species pair
     nematic.tsv                  -> s2.png      S2 vs time; not for spheres
+    density_profile.tsv (walls)  -> density_profile.png  density of centres vs position, per
+                                                        species, one panel per wall axis
+    order_profile.tsv (walls)    -> order_profile.png    s2 and <P2(u.n)> vs position
 
 Units (README): kT = 1, m = 1, lengths l as in the config, time in sqrt(m l^2 / kT). A sphere run
 (summary.json: every "shape" has type "sphere") draws no c2.png or s2.png (both are 1 for
@@ -34,17 +37,22 @@ EXIT_BAD_INPUT = 2
 # Axis labels (README "Units": kT = 1, m = 1, lengths l as in the config).
 TIME_LABEL = "time t  [sqrt(m l^2 / kT)]"
 LENGTH_LABEL = "r  [l]"
+DENSITY_LABEL = "number density of centres  [1/l^3]"
+PROFILE_AXES = {"x": "x from the box centre  [l]", "y": "y from the box centre  [l]",
+                "z": "z from the box centre  [l]", "r": "distance r from the container centre  [l]"}
 
 
 class TableError(Exception):
     """A table that cannot be read; the message names the file (and line)."""
 
 
-def read_table(path: Path) -> tuple[dict[str, str], dict[str, list[float]]]:
+def read_table(path: Path, text_columns: tuple[str, ...] = ()) -> tuple[dict[str, str], dict[str, list]]:
     """Read a hardbody TSV table.
 
     Returns (meta, columns): ``meta`` holds the ``key=value`` pairs of the ``#`` comment lines,
-    ``columns`` maps each header name to its values (``nan``/``inf`` allowed).
+    ``columns`` maps each header name to its values (``nan``/``inf`` allowed). The columns named
+    in ``text_columns`` (e.g. ``axis`` of density_profile.tsv) are kept as strings; all others must be
+    numbers.
     """
     meta: dict[str, str] = {}
     header: list[str] | None = None
@@ -70,7 +78,7 @@ def read_table(path: Path) -> tuple[dict[str, str], dict[str, list[float]]]:
             raise TableError(
                 f"{path}:{lineno}: {len(fields)} fields, header has {len(header)}")
         try:
-            rows.append([float(f) for f in fields])
+            rows.append([f.strip() if name in text_columns else float(f) for name, f in zip(header, fields)])
         except ValueError as e:
             raise TableError(f"{path}:{lineno}: not a number ({e})") from e
     if header is None:
@@ -286,6 +294,81 @@ class Plotter:
         self.legend(ax)
         self.save(fig, "gr_partial.png")
 
+    @staticmethod
+    def profile_blocks(path: Path, columns: dict[str, list]) -> list[tuple[str, list[int]]]:
+        """The axis blocks of a profile table: [(axis, row indices)] in table order."""
+        blocks: list[tuple[str, list[int]]] = []
+        for i, a in enumerate(columns["axis"]):
+            if a not in PROFILE_AXES:
+                raise TableError(f"{path}: axis '{a}' is not one of x, y, z, r")
+            if not blocks or blocks[-1][0] != a:
+                blocks.append((a, []))
+            blocks[-1][1].append(i)
+        if not blocks:
+            raise TableError(f"{path}: no rows")
+        return blocks
+
+    def panels(self, n: int, ylabel: str, title: str):
+        fig, axs = self.plt.subplots(1, n, figsize=(5.2 * n + 1.6, 4.2), squeeze=False)
+        axs = list(axs[0])
+        for ax in axs:
+            ax.grid(True, alpha=0.3)
+        axs[0].set_ylabel(ylabel)
+        fig.suptitle(title, fontsize=10)
+        return fig, axs
+
+    def density_figure(self, path: Path, summary: dict | None = None):
+        """density_profile.tsv: one panel per wall axis (x, y, z: position from the box centre; r:
+        radius), the density of all centres and, for mixtures, of each species; the wall pressure
+        of summary.json in the title when present."""
+        _, c = read_table(path, text_columns=("axis",))
+        require(c, path, "axis", "position", "density")
+        species = [k for k in c if k.startswith("density_")]
+        blocks = self.profile_blocks(path, c)
+        title = "density profiles at the walls"
+        p, p_err = (summary or {}).get("wall_pressure"), (summary or {}).get("wall_pressure_error")
+        if isinstance(p, (int, float)):
+            err = f"{p_err:.2g}" if isinstance(p_err, (int, float)) else "unknown (< 2 blocks)"
+            title += f"   beta P_wall = {p:.6g} +- {err} (summary.json)"
+        fig, axs = self.panels(len(blocks), DENSITY_LABEL, title)
+        for ax, (axis, rows) in zip(axs, blocks):
+            x = [c["position"][i] for i in rows]
+            ax.set_xlabel(PROFILE_AXES[axis])
+            xs, ys = finite_pairs(x, [c["density"][i] for i in rows])
+            ax.plot(xs, ys, "-", lw=1.4, color="black", label="all species")
+            if len(species) > 1:
+                for k in species:
+                    xs, ys = finite_pairs(x, [c[k][i] for i in rows])
+                    ax.plot(xs, ys, "-", lw=1.0, label=k[len("density_"):])
+        self.legend(axs[-1])
+        return fig, axs
+
+    def density_profile(self, path: Path, summary: dict | None = None) -> None:
+        fig, _ = self.density_figure(path, summary)
+        self.save(fig, "density_profile.png")
+
+    def order_figure(self, path: Path):
+        """order_profile.tsv: per wall axis, s2 (nematic order of the long axes in each bin) and
+        p2_normal = <P2(u.n)> (1: along the wall normal, -1/2: in the wall's plane)."""
+        _, c = read_table(path, text_columns=("axis",))
+        require(c, path, "axis", "position", "count", "s2", "p2_normal")
+        blocks = self.profile_blocks(path, c)
+        fig, axs = self.panels(len(blocks), "order parameter", "orientational order profiles (bodies that are not spheres)")
+        for ax, (axis, rows) in zip(axs, blocks):
+            x = [c["position"][i] for i in rows]
+            ax.set_xlabel(PROFILE_AXES[axis])
+            for key, label in (("s2", "s2 (nematic)"), ("p2_normal", "<P2(u.n)> (wall normal)")):
+                xs, ys = finite_pairs(x, [c[key][i] for i in rows])
+                ax.plot(xs, ys, ".-", ms=2, lw=1.0, label=label)
+            for y in (0.0, -0.5, 1.0):
+                ax.axhline(y, color="gray", lw=0.6, ls=":" if y else "-")
+        self.legend(axs[-1])
+        return fig, axs
+
+    def order_profile(self, path: Path) -> None:
+        fig, _ = self.order_figure(path)
+        self.save(fig, "order_profile.png")
+
     def nematic(self, path: Path) -> None:
         self.simple(path, "time", "S2", "s2.png", "nematic order parameter", xlabel=TIME_LABEL,
                     ylabel="S2")
@@ -325,6 +408,11 @@ def main(argv: list[str]) -> int:
         jobs.append((run_dir / "nematic.tsv", plotter.nematic, "s2.png"))
     if (run_dir / "gr_partial.tsv").is_file():  # mixtures only: no note when absent
         jobs.append((run_dir / "gr_partial.tsv", plotter.gr_partial, "gr_partial.png"))
+    if (run_dir / "density_profile.tsv").is_file():  # runs with walls only: no note when absent
+        jobs.append((run_dir / "density_profile.tsv", lambda p: plotter.density_profile(p, summary),
+                     "density_profile.png"))
+    if (run_dir / "order_profile.tsv").is_file():
+        jobs.append((run_dir / "order_profile.tsv", plotter.order_profile, "order_profile.png"))
     try:
         for path, plot, outputs in jobs:
             if not path.is_file():

@@ -1,5 +1,6 @@
-// Writes correlations.tsv, gr.tsv and nematic.tsv of a small free-flight system into the
-// directory given as argv[1], with the observers' own to_tsv(), for the plot script's test.
+// Writes correlations.tsv, gr.tsv and nematic.tsv of a small free-flight system, and
+// density_profile.tsv and order_profile.tsv of a two-species gas between walls on x and z, into
+// the directory given as argv[1], with the observers' own writers, for the plot script's test.
 #include <fstream>
 #include <iostream>
 #include <pcg_random.hpp>
@@ -7,6 +8,7 @@
 
 #include "observers/correlations.hpp"
 #include "observers/structure.hpp"
+#include "observers/wall_observables.hpp"
 
 using namespace hb;
 
@@ -51,5 +53,24 @@ int main(int argc, char** argv) {
   std::ofstream(dir + "/correlations.tsv") << corr.to_tsv();
   std::ofstream(dir + "/gr.tsv") << rdf.to_tsv();
   std::ofstream(dir + "/nematic.tsv") << nematic.to_tsv();
+
+  // Walls on x and z: ideal gas of spheres (A) and rods (B) whose long axes lean towards the
+  // walls' normal near the walls.
+  WallSpec walls;
+  walls.planes = {true, false, true};
+  DensityProfiles prof(walls, box, {{"A", true, 0}, {"B", false, 0}}, 0.2);
+  for (int k = 0; k < 20; ++k) {
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      s.r[i] = 8.0 * Vec3(uni(rng), uni(rng), uni(rng));
+      s.species[i] = i % 3 == 0 ? 0 : 1;
+      const double near = std::exp(-std::min(s.r[i].z(), 8.0 - s.r[i].z()));
+      const Vec3 u = (Vec3(g(rng), g(rng), g(rng)) + 3.0 * near * Vec3::UnitZ()).normalized();
+      s.q[i] = Quat::FromTwoVectors(Vec3::UnitX(), u);
+      s.t[i] = 0.0;
+    }
+    prof.sample(0.0, s, box);
+  }
+  std::ofstream(dir + "/density_profile.tsv") << prof.to_tsv();
+  std::ofstream(dir + "/order_profile.tsv") << prof.order_tsv();
   return 0;
 }

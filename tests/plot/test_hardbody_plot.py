@@ -69,6 +69,33 @@ def write_nematic(run):
               comments=["hardbody nematic order", "S2_mean=0.03 S2_error=0.001 samples=20"])
 
 
+def write_density_profile(run, axes=("z",), species=("A", "B")):
+    rows = []
+    for axis in axes:
+        for k in range(50):
+            x = 0.2 * (k + 0.5) if axis == "r" else -5.0 + 0.2 * (k + 0.5)
+            d = x if axis == "r" else 5.0 - abs(x)
+            rho = [0.0 if d < 0.5 else 0.3 * (1.0 + 0.5 * math.exp(-(d - 0.5)) * math.cos(6 * d)) * (j + 1)
+                   for j in range(len(species))]
+            rows.append([axis, x, sum(rho), *rho])
+    write_tsv(run / "density_profile.tsv", ["axis", "position", "density", *[f"density_{s}" for s in species]],
+              rows, comments=["hardbody density profiles", "samples=10 species=2"])
+
+
+def write_order_profile(run, axes=("z",)):
+    rows = []
+    for axis in axes:
+        for k in range(50):
+            x = -5.0 + 0.2 * (k + 0.5)
+            d = 5.0 - abs(x)
+            count = 0 if d < 0.5 else 100
+            s2 = float("nan") if count == 0 else 0.05 + 0.5 * math.exp(-d)
+            p2 = float("nan") if count == 0 else -0.4 * math.exp(-d)
+            rows.append([axis, x, count, s2, p2])
+    write_tsv(run / "order_profile.tsv", ["axis", "position", "count", "s2", "p2_normal"], rows,
+              comments=["hardbody order profiles", "samples=10"])
+
+
 def assert_pngs(run, names):
     for name in names:
         p = run / name
@@ -141,7 +168,7 @@ def test_tables_written_by_the_observers(tmp_path):
     write_log(tmp_path)
     res = run_plot(tmp_path)
     assert res.returncode == 0, res.stderr
-    assert_pngs(tmp_path, ALL_PNGS)
+    assert_pngs(tmp_path, ALL_PNGS + ["density_profile.png", "order_profile.png"])
     # The comment lines carry q and the D fit in key=value form.
     sys.path.insert(0, str(SCRIPT.parent))
     import hardbody_plot
@@ -150,6 +177,20 @@ def test_tables_written_by_the_observers(tmp_path):
     assert abs(float(meta["q"]) - 2 * math.pi) < 0.1
     assert cols["time"][0] == 0.0 and cols["msd"][0] == 0.0 and cols["c2"][0] == 1.0
     assert len(cols["time"]) == 41
+    # The wall profiles: axis blocks x then z (box 8, bins 0.2), positions from the box centre,
+    # density = the sum of the species' densities; 300 bodies x 20 samples over 8^3.
+    meta, cols = hardbody_plot.read_table(tmp_path / "density_profile.tsv", text_columns=("axis",))
+    assert list(cols) == ["axis", "position", "density", "density_A", "density_B"]
+    assert cols["axis"] == ["x"] * 40 + ["z"] * 40
+    assert cols["position"][0] == pytest.approx(-3.9) and cols["position"][39] == pytest.approx(3.9)
+    for t, a, b in zip(cols["density"], cols["density_A"], cols["density_B"]):
+        assert t == pytest.approx(a + b)
+    assert sum(cols["density"][:40]) / 40 == pytest.approx(300 / 512)
+    assert meta["samples"] == "20" and meta["bins_z"] == "40"
+    _, cols = hardbody_plot.read_table(tmp_path / "order_profile.tsv", text_columns=("axis",))
+    assert list(cols) == ["axis", "position", "count", "s2", "p2_normal"]
+    z = [k for k, a in enumerate(cols["axis"]) if a == "z"]
+    assert cols["p2_normal"][z[0]] > cols["p2_normal"][z[20]]  # along the normal at the wall
 
 
 def import_plot_module():
@@ -251,3 +292,60 @@ def test_unreadable_summary_exits_2_naming_it(tmp_path):
     assert res.returncode == 2
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and "summary.json" in lines[0], res.stderr
+
+
+def test_wall_profiles_draw_one_panel_per_axis(tmp_path):
+    hp = import_plot_module()
+    write_density_profile(tmp_path, axes=("x", "z"))
+    write_order_profile(tmp_path, axes=("x", "z"))
+    plotter = hp.Plotter(tmp_path)
+    fig, axs = plotter.density_figure(tmp_path / "density_profile.tsv",
+                                      {"wall_pressure": 1.234, "wall_pressure_error": 0.01})
+    assert len(axs) == 2
+    assert "x from the box centre" in axs[0].get_xlabel() and "z" in axs[1].get_xlabel()
+    assert "1/l^3" in axs[0].get_ylabel()
+    assert [l.get_label() for l in axs[0].get_lines()] == ["all species", "A", "B"]
+    assert "beta P_wall = 1.234 +- 0.01" in fig._suptitle.get_text()
+    # Each panel holds its own axis block (the rows below the contact distance are zeros).
+    xs = axs[1].get_lines()[0].get_xdata()
+    assert len(xs) == 50 and min(xs) == pytest.approx(-4.9) and max(xs) == pytest.approx(4.9)
+    plotter.plt.close(fig)
+    fig, axs = plotter.order_figure(tmp_path / "order_profile.tsv")
+    assert len(axs) == 2
+    labels = [l.get_label() for l in axs[0].get_lines() if not l.get_label().startswith("_")]
+    assert labels == ["s2 (nematic)", "<P2(u.n)> (wall normal)"]
+    assert len(axs[0].get_lines()[0].get_xdata()) == 46  # the empty bins (nan) are left out
+    plotter.plt.close(fig)
+
+
+def test_wall_profiles_are_plotted_when_present(tmp_path):
+    write_log(tmp_path)
+    write_density_profile(tmp_path, axes=("r",), species=("A",))
+    write_order_profile(tmp_path)
+    res = run_plot(tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert_pngs(tmp_path, ["Z.png", "density_profile.png", "order_profile.png"])
+    assert "density_profile.png" in res.stdout and "order_profile.png" in res.stdout
+
+
+def test_wall_profiles_absent_give_no_note(tmp_path):
+    write_log(tmp_path)
+    res = run_plot(tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert "density_profile" not in res.stderr and "order_profile" not in res.stderr
+    assert not (tmp_path / "density_profile.png").exists()
+
+
+def test_bad_profile_axis_exits_2_naming_the_file(tmp_path):
+    write_tsv(tmp_path / "density_profile.tsv", ["axis", "position", "density"], [["w", 0.5, 1.0]])
+    res = run_plot(tmp_path)
+    assert res.returncode == 2
+    assert "density_profile.tsv" in res.stderr and "'w'" in res.stderr
+
+
+def test_profile_with_a_non_number_exits_2_naming_the_line(tmp_path):
+    write_tsv(tmp_path / "order_profile.tsv", ["axis", "position", "count", "s2", "p2_normal"],
+              [["z", 0.5, 3, 0.2, 0.1], ["z", 0.7, "many", 0.2, 0.1]])
+    res = run_plot(tmp_path)
+    assert res.returncode == 2
+    assert "order_profile.tsv:3" in res.stderr
