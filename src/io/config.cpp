@@ -13,6 +13,7 @@
 
 #include "io/resources.hpp"
 #include "io/suggest.hpp"
+#include "setup/box_setup.hpp"
 #include "shapes/codec.hpp"
 #include "shapes/inertia.hpp"
 
@@ -22,7 +23,7 @@ namespace hb {
 
 namespace {
 
-enum class Kind { Int, Float, String, Bool, Vec3 };
+enum class Kind { Int, Float, String, Bool, Vec3, Strings };
 
 // THE schema of the scalar sections: every key with its kind and meaning. Unknown keys are
 // rejected against it, and docs/config.md is generated from it (config_reference()).
@@ -35,13 +36,19 @@ struct KeySpec {
 const std::vector<KeySpec>& key_specs() {
   static const std::vector<KeySpec> k = {
       {"system", "particles", Kind::Int, "N, the number of bodies (one-species shorthand, required with [shape]; with [[species]] the counts add up and this key is refused)"},
-      {"system", "packing_fraction", Kind::Float, "target packing fraction phi = sum of body volumes / box volume (required)"},
+      {"system", "packing_fraction", Kind::Float, "target packing fraction phi = sum of body volumes / box volume (required; with walls.sphere it may be omitted: phi is then the bodies' volume over the container's, and a value given must agree with it to 1e-6)"},
       {"system", "seed", Kind::Int, "seed of every random choice (lattice velocities, placement, polydispersity)"},
       {"system", "temperature", Kind::Float, "kT: the translational (and rotational) temperature set at the start"},
       {"system", "mass", Kind::Float, "body mass (one-species shorthand; per species with [[species]])"},
+      {"box", "aspect", Kind::Vec3, "side ratios Lx : Ly : Lz of the box (three positive numbers); the volume is sum of body volumes / phi, so L = aspect x cbrt(V / (ax ay az)). With walls.sphere only [1, 1, 1]"},
+      {"walls", "planes", Kind::Strings, "axes with hard planar walls, a list of distinct names among \"x\", \"y\", \"z\" (e.g. [\"z\"]: walls at -Lz/2 and +Lz/2, the box not periodic along z); [] for none. A walled side shorter than two body lengths (2 x the largest bounding diameter) is refused"},
+      {"walls", "sphere", Kind::Float, "radius R of a hard spherical container centred in the box (a cube of side 2 R, periodic along no axis); phi = N v / (4 pi R^3 / 3). Excludes walls.planes (other than []) and a non-cubic box.aspect; R must be at least two body lengths; default: no container"},
       {"run", "equilibrate_time", Kind::Float, "simulated time run and discarded before measuring"},
       {"run", "time", Kind::Float, "simulated time measured (required)"},
       {"run", "max_collisions", Kind::Int, "stop the measured run after this many collisions (0: no limit)"},
+      {"thermostat", "type", Kind::String, "\"none\" (NVE) or \"andersen\": each body's velocity and spin redrawn from the Maxwell distribution at system.temperature at the events of a Poisson process of thermostat.rate per body"},
+      {"thermostat", "rate", Kind::Float, "resamplings per body per unit time (finite, > 0 with type = \"andersen\"; never negative)"},
+      {"thermostat", "during", Kind::String, "\"always\" or \"equilibration\" (only in run.equilibrate_time, which must then be positive)"},
       {"neighbors", "method", Kind::String, "\"cells\" or \"nnl\" (oriented-box / sphere-shell neighbour lists); default cells when every species is a sphere, nnl otherwise; sphere mixtures use cells"},
       {"neighbors", "shell", Kind::Float, "Delta_NNL: the neighbour-list shell (a length)"},
       {"solver", "eps_d", Kind::Float, "the paper's epsilon_d: the distance accuracy of the contact-time search"},
@@ -439,6 +446,63 @@ void apply_override(toml::table& root, const std::string& ov) {
   parsed.get("v")->visit([&](auto&& v) { t->insert_or_assign(key, std::move(v)); });
 }
 
+// [box] and [walls] as given (each key typed and in range; the geometry is checked by validate).
+void read_boundaries(const Reader& r, BoundarySpec& b) {
+  r.vec3("box", "aspect", b.aspect);
+  if (!(b.aspect.minCoeff() > 0.0))
+    r.fail(r.node("box", "aspect"), "box.aspect",
+           fmt::format("must be three positive side ratios (got [{}, {}, {}])", b.aspect.x(), b.aspect.y(), b.aspect.z()));
+  if (const auto* n = r.node("walls", "planes")) {
+    const auto* a = n->as_array();
+    if (!a) r.fail(n, "walls.planes", "must be a list of axis names, e.g. [\"z\"] ([] for none)");
+    for (const auto& e : *a) {
+      const auto axis = e.value_exact<std::string>();
+      if (!axis || (*axis != "x" && *axis != "y" && *axis != "z"))
+        r.fail(&e, "walls.planes",
+               axis ? fmt::format("\"{}\" is not an axis: list names among \"x\", \"y\", \"z\"", *axis)
+                    : std::string("must list axis names (strings) among \"x\", \"y\", \"z\", e.g. [\"z\"]"));
+      const int k = (*axis)[0] - 'x';
+      if (b.walls.planes[k]) r.fail(&e, "walls.planes", fmt::format("names the axis \"{}\" twice", *axis));
+      b.walls.planes[k] = true;
+    }
+  }
+  if (const auto* n = r.node("walls", "sphere")) {
+    const double radius = r.num(n, "walls.sphere");
+    if (!(radius > 0.0)) r.fail(n, "walls.sphere", fmt::format("must be a positive radius (got {})", radius));
+    if (b.walls.any_plane())
+      r.fail(n, "walls.sphere", "walls.planes and walls.sphere exclude each other (planar walls or a spherical container)");
+    if (b.aspect != Vec3::Ones())
+      r.fail(r.node("box", "aspect"), "box.aspect",
+             fmt::format("must be [1, 1, 1] (or absent) with walls.sphere: the container's box is the cube of side "
+                         "2 R (got [{}, {}, {}])", b.aspect.x(), b.aspect.y(), b.aspect.z()));
+    b.walls.sphere_radius = radius;
+  }
+}
+
+// A spherical container sets phi = N v / (4 pi R^3 / 3): system.packing_fraction, if given, must
+// agree with it to 1e-6 (relative); c.packing_fraction becomes the container's phi either way.
+void check_container(const Reader& r, Config& c, bool phi_given) {
+  const WallSpec& w = c.boundaries.walls;
+  if (!w.container()) return;
+  const double phi = packing_fraction(c);
+  const auto* sphere = r.node("walls", "sphere");
+  if (!std::isnormal(phi))
+    r.fail(sphere, "walls.sphere", fmt::format("radius {} is too large: the bodies would fill {} of the container",
+                                               w.sphere_radius, phi));
+  if (phi_given && !(std::abs(phi - c.packing_fraction) <= 1e-6 * c.packing_fraction)) {
+    const double need = container_radius_for(c, c.packing_fraction);
+    if (phi > c.packing_fraction)
+      r.fail(sphere, "walls.sphere",
+             fmt::format("the container is too small for {} bodies at phi = {}: it needs radius {:.10g} (radius {} "
+                         "gives phi = {:.6g})", c.particles, c.packing_fraction, need, w.sphere_radius, phi));
+    r.fail(sphere, "walls.sphere",
+           fmt::format("the container is larger than {} bodies at phi = {} need (radius {:.10g}; radius {} gives "
+                       "phi = {:.6g}); omit system.packing_fraction or set walls.sphere = {:.10g}",
+                       c.particles, c.packing_fraction, need, w.sphere_radius, phi, need));
+  }
+  c.packing_fraction = phi;
+}
+
 Config validate(const std::string& file, const toml::table& root) {
   check_unknown_keys(file, root);
   Reader r{file, root};
@@ -464,7 +528,9 @@ Config validate(const std::string& file, const toml::table& root) {
       throw ConfigError(fmt::format("{}: missing key '{}.{}'", file, sec, key));
   };
   if (!species) require("system", "particles");
-  require("system", "packing_fraction");
+  // with a spherical container phi follows from its radius (a value given must agree)
+  const bool phi_given = r.get("system", "packing_fraction") != nullptr;
+  if (!r.get("walls", "sphere")) require("system", "packing_fraction");
   if (!species) require("shape", "type");
   require("run", "time");
 
@@ -498,27 +564,24 @@ Config validate(const std::string& file, const toml::table& root) {
   r.integer("observables", "q_vectors", c.obs_q_vectors);
   r.real("observables", "gr_interval", c.gr_interval);
   r.integer("observables", "gr_bins", c.gr_bins);
+  read_boundaries(r, c.boundaries);
+  std::string thermostat_type = "none", thermostat_during = "always";
+  r.string("thermostat", "type", thermostat_type);
+  r.real("thermostat", "rate", c.thermostat.rate);
+  r.string("thermostat", "during", thermostat_during);
 
   auto bad = [&](const char* sec, const char* key, const std::string& what) {
     r.fail(r.node(sec, key), std::string(sec) + "." + key, what);
   };
   if (!species && c.particles == 0) bad("system", "particles", "must be at least 1 (got 0)");
   if (c.particles > 100000000) bad("system", "particles", "must be at most 1e8");
-  if (!(c.packing_fraction > 0.0)) bad("system", "packing_fraction", "must be positive");
+  if (phi_given && !(c.packing_fraction > 0.0)) bad("system", "packing_fraction", "must be positive");
   if (!(c.temperature > 0.0)) bad("system", "temperature", "must be positive");
 
   if (species) {
     c.species = read_species(r, *species);
     c.particles = total_count(c.species);
     if (c.particles > 100000000) r.fail(species, "species", "the counts must add up to at most 1e8");
-    const bool one_kind = c.species.size() == 1 && !c.species[0].poly.active();
-    const PackingLimit lim = packing_limit(c.species[0].shape);
-    if (one_kind && c.packing_fraction >= lim.phi)
-      bad("system", "packing_fraction", fmt::format("{} is not below {} ({})", c.packing_fraction, lim.phi, lim.note));
-    if (!one_kind && c.packing_fraction > kMixtureStartLimit)
-      bad("system", "packing_fraction",
-          fmt::format("{} is too dense for the start of a mixture (random placement, then growth: at most {})",
-                      c.packing_fraction, kMixtureStartLimit));
   } else {
     if (!(mass > 0.0)) bad("system", "mass", "must be positive");
     Species sp;
@@ -526,15 +589,28 @@ Config validate(const std::string& file, const toml::table& root) {
     sp.name = std::string(shape_name(sp.shape));
     sp.count = c.particles;
     sp.mass = mass;
-    const PackingLimit lim = packing_limit(sp.shape);
-    if (c.packing_fraction >= lim.phi)
-      bad("system", "packing_fraction",
-          fmt::format("{} is not below {} ({})", c.packing_fraction, lim.phi, lim.note));
     if (r.get("shape", "inertia") && !(inertia > 0.0)) bad("shape", "inertia", "must be positive");
     // the paper's convention for the shorthand: a spherical top, I = 2/5 m r_min^2 (ERRATA 8)
     if (inertia == 0.0) inertia = 0.4 * mass * sqr(half_extents(sp.shape).minCoeff());
     sp.inertia = Vec3::Constant(inertia);
     c.species = {sp};
+  }
+  check_container(r, c, phi_given);
+  {
+    // with a container whose radius alone sets phi, a phi out of range is the radius' fault
+    auto bad_phi = [&](const std::string& what) {
+      if (c.boundaries.walls.container() && !phi_given)
+        bad("walls", "sphere", fmt::format("the bodies fill phi = N v / (4 pi R^3 / 3) = {} of the container, and {}; "
+                                           "a larger radius is needed", c.packing_fraction, what));
+      bad("system", "packing_fraction", what);
+    };
+    const bool one_kind = !c.mixture();
+    const PackingLimit lim = packing_limit(c.species[0].shape);
+    if (one_kind && c.packing_fraction >= lim.phi)
+      bad_phi(fmt::format("{} is not below {} ({})", c.packing_fraction, lim.phi, lim.note));
+    if (!one_kind && c.packing_fraction > kMixtureStartLimit)
+      bad_phi(fmt::format("{} is too dense for the start of a mixture (random placement, then growth: at most {})",
+                          c.packing_fraction, kMixtureStartLimit));
   }
   if (c.equilibrate_time < 0.0) bad("run", "equilibrate_time", "must not be negative");
   if (!(c.time > 0.0)) bad("run", "time", "must be positive");
@@ -594,6 +670,25 @@ Config validate(const std::string& file, const toml::table& root) {
   if (c.obs_q_vectors < 1 || c.obs_q_vectors > 100000) bad("observables", "q_vectors", "must be in 1..100000");
   if (c.gr_interval < 0.0) bad("observables", "gr_interval", "must not be negative (0 switches it off)");
   if (c.gr_bins < 1 || c.gr_bins > 100000) bad("observables", "gr_bins", "must be in 1..100000");
+  // [thermostat]
+  if (thermostat_type == "none") c.thermostat.type = ThermostatSpec::Type::none;
+  else if (thermostat_type == "andersen") c.thermostat.type = ThermostatSpec::Type::andersen;
+  else bad("thermostat", "type", fmt::format("must be \"none\" or \"andersen\" (got \"{}\")", thermostat_type));
+  if (c.thermostat.rate < 0.0)
+    bad("thermostat", "rate", fmt::format("must not be negative (got {}; resamplings per body per unit time)",
+                                          c.thermostat.rate));
+  if (c.thermostat.active() && !(c.thermostat.rate > 0.0))
+    bad("thermostat", "rate", "thermostat.type = \"andersen\" needs a positive rate (resamplings per body per unit time)");
+  if (thermostat_during == "always") c.thermostat.during = ThermostatSpec::During::always;
+  else if (thermostat_during == "equilibration") c.thermostat.during = ThermostatSpec::During::equilibration;
+  else bad("thermostat", "during", fmt::format("must be \"always\" or \"equilibration\" (got \"{}\")", thermostat_during));
+  if (c.thermostat.active() && c.thermostat.during == ThermostatSpec::During::equilibration && c.equilibrate_time == 0.0)
+    bad("thermostat", "during", "is \"equilibration\" but run.equilibrate_time = 0: the thermostat would never act");
+  // the box and its walls against the bodies (setup/box_setup.hpp)
+  if (const auto p = boundary_problem(c)) {
+    const auto dot = p->key.find('.');
+    r.fail(r.node(p->key.substr(0, dot), p->key.substr(dot + 1)), p->key, p->what);
+  }
   return c;
 }
 
@@ -683,7 +778,8 @@ std::string toml_value(const toml::node& n) {
 
 // Sections in reading order ([system] and the bodies first), arrays of tables as [[name]].
 std::string toml_text(const toml::table& root) {
-  std::vector<std::string> order{"system", "shape", "species", "run", "neighbors", "init", "solver", "output", "observables"};
+  std::vector<std::string> order{"system", "shape", "species", "box", "walls", "run", "thermostat",
+                                 "neighbors", "init", "solver", "output", "observables"};
   for (const auto& [k, v] : root)
     if (std::find(order.begin(), order.end(), k.str()) == order.end()) order.emplace_back(k.str());
   std::string out;
@@ -761,6 +857,23 @@ std::string to_toml(const Config& c) {
     if (c.init_frame != kLastFrame) init.insert("frame", static_cast<std::int64_t>(c.init_frame));
   }
   root.insert("init", init);
+  const Vec3& a = c.boundaries.aspect;
+  root.insert("box", toml::table{{"aspect", toml::array{a.x(), a.y(), a.z()}}});
+  toml::table walls;  // planar walls (a list, maybe empty) or the container: they exclude each other
+  if (c.boundaries.walls.container()) {
+    walls.insert("sphere", c.boundaries.walls.sphere_radius);
+  } else {
+    toml::array planes;
+    for (int k = 0; k < 3; ++k)
+      if (c.boundaries.walls.planes[k]) planes.push_back(std::string(1, char('x' + k)));
+    walls.insert("planes", std::move(planes));
+  }
+  root.insert("walls", std::move(walls));
+  const ThermostatSpec& th = c.thermostat;
+  root.insert("thermostat",
+              toml::table{{"type", th.type == ThermostatSpec::Type::andersen ? "andersen" : "none"},
+                          {"rate", th.rate},
+                          {"during", th.during == ThermostatSpec::During::equilibration ? "equilibration" : "always"}});
   return "# hardbody resolved configuration (every key, defaults filled in)\n" + toml_text(root);
 }
 
@@ -772,6 +885,7 @@ const char* kind_doc(Kind k) {
     case Kind::String: return "string";
     case Kind::Bool: return "bool";
     case Kind::Vec3: return "3 numbers";
+    case Kind::Strings: return "list of strings";
   }
   return "?";
 }
@@ -791,9 +905,11 @@ std::string config_reference() {
       "[run]\ntime = 1.0\n", "defaults");
   const toml::table resolved = toml::parse(to_toml(defaults));
   auto default_of = [&](const std::string& sec, const std::string& key) -> std::string {
-    if ((sec == "system" && (key == "particles" || key == "packing_fraction")) || (sec == "run" && key == "time"))
+    if ((sec == "system" && key == "particles") || (sec == "run" && key == "time"))
       return "required";
+    if (sec == "system" && key == "packing_fraction") return "required (or walls.sphere)";
     if (sec == "neighbors" && key == "method") return "by shape";
+    if (sec == "walls" && key == "sphere") return "none";
     const auto* t = resolved.get_as<toml::table>(sec);
     const auto* n = t ? t->get(key) : nullptr;
     if (!n) return "";
@@ -801,6 +917,15 @@ std::string config_reference() {
     if (auto i = n->value_exact<int64_t>()) return fmt::format("{}", *i);
     if (auto b = n->value_exact<bool>()) return *b ? "true" : "false";
     if (auto str = n->value_exact<std::string>()) return "\"" + *str + "\"";
+    if (const auto* a = n->as_array()) {
+      std::string out = "[";
+      for (std::size_t k = 0; k < a->size(); ++k) {
+        const auto* e = a->get(k);
+        out += (k ? ", " : "") + (e->value_exact<double>() ? fmt::format("{:g}", *e->value_exact<double>())
+                                                           : toml_value(*e));
+      }
+      return out + "]";
+    }
     return "";
   };
   std::string out =
@@ -809,7 +934,8 @@ std::string config_reference() {
       "(`hardbody config-reference > docs/config.md`; a test fails when this file is out of date).\n"
       "Every key is checked: an unknown key, a wrong type or a value out of range stops the program with\n"
       "exit status 2 and one message naming the file, the key and the line. `--set section.key=value`\n"
-      "overrides any scalar key.\n";
+      "overrides any key of a [section] (not of a [[species]] entry); the value is a TOML literal, a bare word a string\n"
+      "(`--set neighbors.method=nnl`, `--set box.aspect=[1,1,2]`, `--set 'walls.planes=[\"z\"]'`).\n";
   std::string sec;
   for (const KeySpec& k : key_specs()) {
     if (k.section != sec) {
@@ -840,6 +966,23 @@ std::string config_reference() {
          "`system.packing_fraction` (at most 0.6). Non-spherical mixtures take either neighbour method\n"
          "(per-body boxes with NNL); sphere mixtures use cell lists. Any shapes may be mixed; a body\n"
          "whose principal moments differ rotates as the exact free symmetric or asymmetric top.\n";
+  out += "\n## Boxes, walls and the thermostat\n\n"
+         "The box has the volume V = (sum of body volumes) / phi (with polydispersity, of the sizes drawn from\n"
+         "`system.seed`) and the sides L = aspect x cbrt(V / (ax ay az)); it is periodic along every axis\n"
+         "without walls. `walls.planes` puts hard walls at the two faces normal to each axis listed (at\n"
+         "-L/2 and +L/2 from the box centre). `walls.sphere = R` puts the bodies in a hard spherical container\n"
+         "of radius R instead: the box is the cube of side 2 R around it, periodic along no axis, and phi is\n"
+         "the bodies' volume over 4 pi R^3 / 3, so `system.packing_fraction` may be omitted\n"
+         "(`config.resolved.toml` records the container's phi). A body length is the largest bounding\n"
+         "diameter over the species (at the largest polydisperse scale). Each of these stops the program\n"
+         "(exit status 2) with one message naming the key:\n\n"
+         "| key | refused |\n|---|---|\n"
+         "| `box.aspect` | a side ratio that is not a positive finite number; an aspect other than [1, 1, 1] with `walls.sphere`; a periodic side shorter than two body lengths (a non-cubic box) |\n"
+         "| `walls.planes` | not a list of distinct names among \"x\", \"y\", \"z\"; a walled side shorter than two body lengths (both lengths are given) |\n"
+         "| `walls.sphere` | a radius that is not positive and finite; beside a non-empty `walls.planes` (\"walls.planes and walls.sphere exclude each other\"); a radius below two body lengths; a `system.packing_fraction` that differs from the container's by more than 1e-6 (relative): \"the container is too small for N bodies at phi: it needs radius R\", or \"the container is larger than N bodies at phi need (radius R); omit system.packing_fraction or set walls.sphere = R\"; without `system.packing_fraction`, a container too small for the densest start |\n"
+         "| `thermostat.type` | anything but \"none\" and \"andersen\" |\n"
+         "| `thermostat.rate` | a negative or non-finite rate (whatever the type); with \"andersen\", a rate that is not positive |\n"
+         "| `thermostat.during` | anything but \"always\" and \"equilibration\"; \"equilibration\" with \"andersen\" and `run.equilibrate_time = 0` |\n";
   return out;
 }
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "math/types.hpp"
+#include "core/boundaries.hpp"
 #include "core/species.hpp"
 #include "shapes/registry.hpp"
 
@@ -24,7 +25,7 @@ struct Config {
   std::string source;  // file the config was read from
   // [system]
   std::uint64_t particles = 0;  // N: the total over the species
-  double packing_fraction = 0.0;
+  double packing_fraction = 0.0;  // optional with walls.sphere: the reader sets N v / V_container
   std::uint64_t seed = 1;
   double temperature = 1.0;
   // [[species]], or the one-species shorthand [shape] + system.particles + system.mass (+
@@ -35,6 +36,11 @@ struct Config {
 
   const Species& one() const { return species.front(); }  // the species of a one-species run
   bool mixture() const { return species.size() > 1 || species.front().poly.active(); }
+  // [box], [walls]: the box's side ratios, hard planar walls or a spherical container (the box
+  // itself: setup/box_setup.hpp box_for)
+  BoundarySpec boundaries;
+  // [thermostat]
+  ThermostatSpec thermostat;
   // [run]
   double equilibrate_time = 0.0;
   double time = 0.0;
