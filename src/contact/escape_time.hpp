@@ -32,6 +32,11 @@
 //  4. Every bracket of the step is shrunk on the sign of d_f (Illinois + bisection) to a width
 //     of a few ulps of t and its left end (d_f >= 0) is kept; the earliest face wins. The time
 //     returned is therefore never later than the first contact with the shrunken box.
+// Growth: with scale s(t) = scale + scale_rate (t - t_state) the body is its shape scaled by s(t)
+// about its centre (Lubachevsky–Stillinger starts against walls, locals/planar_walls.hpp):
+// d_f(t) = c - margin - n.r(t) - s(t) h(R(t)^T n), d_f' gains -s' h and its rotational part the
+// factor s(t), and K_f = |n.v| + |w x n| L s_max + |s'| L with s_max the larger scale of the window
+// (a growing body needs a finite t_max).
 // Shrunken box: the search runs against the box shrunk by `margin`. A dip that step 3 missed
 // is at most (d0 + d1 - K_f dt) / 2 >= -eps / 2 deep (Lipschitz), so with margin >= eps / 2 the
 // body is still inside the real box, and every returned time precedes the first contact with
@@ -63,6 +68,8 @@ struct EscapeInput {
   Obb box;
   double margin = 0.0;    // the box is shrunk by this on every face (>= eps / 2, see above)
   double eps = 1e-3;      // grazing step length (the paper's epsilon_d^nnl), << body size
+  double scale = 1.0;     // growth: the body's scale at t_state and its rate (see above)
+  double scale_rate = 0.0;
 };
 
 struct EscapeOptions {
@@ -91,12 +98,17 @@ struct BoxDistance {
   Vec3 lim;              // half - margin
   double L;
   Motion motion;         // the rotation (any top; motion/motion.hpp)
+  double s0 = 1.0, sdot = 0.0;  // growth: scale s(t) = s0 + sdot (t - t_state)
+  double smax = 1.0;            // bound of s(t) over the search window
 
-  BoxDistance(const S& s, const BodyState& b, double ts, const Obb& box, double margin)
+  BoxDistance(const S& s, const BodyState& b, double ts, const Obb& box, double margin,
+              double scale = 1.0, double scale_rate = 0.0, double t_end = kInf)
       : shape(s), st(b), t_state(ts), axes(box.axes), lim(box.half.array() - margin),
-        L(s.bounding_radius()), motion(b) {
+        L(s.bounding_radius()), motion(b), s0(scale), sdot(scale_rate),
+        smax(scale_rate > 0.0 ? scale + scale_rate * (t_end - ts) : scale) {
     st.r = b.r - box.centre;
   }
+  double scale_at(double t) const { return sdot == 0.0 ? s0 : s0 + sdot * (t - t_state); }
   // d_f at t for every face; with rates when dd is non-null.
   void at(double t, std::array<double, 6>& d, std::array<double, 6>* dd = nullptr) const {
     const double tau = t - t_state;
@@ -107,17 +119,19 @@ struct BoxDistance {
     const Mat3 R = q.toRotationMatrix();
     const Vec3 x = axes.transpose() * r;        // centre along the box axes
     const Mat3 Rn = R.transpose() * axes;       // column k: box axis k in the body frame
+    const double sc = scale_at(t);
     for (int k = 0; k < 3; ++k) {
       const Vec3 nb = Rn.col(k);
-      d[2 * k] = lim[k] + x[k] - shape.support(-nb);
-      d[2 * k + 1] = lim[k] - x[k] - shape.support(nb);
+      const double hm = shape.support(-nb), hp = shape.support(nb);
+      d[2 * k] = lim[k] + x[k] - sc * hm;
+      d[2 * k + 1] = lim[k] - x[k] - sc * hp;
       if (dd) {
         const Vec3 u = axes.col(k);
         const Vec3 wxu = w.cross(u);
         const double vn = st.v.dot(u);
         const Vec3 pm = R * shape.support_point(-nb), pp = R * shape.support_point(nb);
-        (*dd)[2 * k] = vn - pm.dot(wxu);
-        (*dd)[2 * k + 1] = -vn + pp.dot(wxu);
+        (*dd)[2 * k] = vn - sc * pm.dot(wxu) - sdot * hm;
+        (*dd)[2 * k + 1] = -vn + sc * pp.dot(wxu) - sdot * hp;
       }
     }
   }
@@ -127,7 +141,7 @@ struct BoxDistance {
     const Vec3 u = (f & 1) ? Vec3(axes.col(k)) : Vec3(-axes.col(k));
     const Vec3 r = st.r + st.v * tau;
     const Mat3 R = motion.rotation(tau);
-    return lim[k] - u.dot(r) - shape.support(R.transpose() * u);
+    return lim[k] - u.dot(r) - scale_at(t) * shape.support(R.transpose() * u);
   }
   double face_rate(int f, double t) const {
     const double tau = t - t_state;
@@ -137,20 +151,23 @@ struct BoxDistance {
     Vec3 w;
     motion.pose(tau, q, w);
     const Mat3 R = q.toRotationMatrix();
-    return -u.dot(st.v) + (R * shape.support_point(R.transpose() * u)).dot(w.cross(u));
+    const Vec3 nb = R.transpose() * u;
+    return -u.dot(st.v) + scale_at(t) * (R * shape.support_point(nb)).dot(w.cross(u)) -
+           sdot * shape.support(nb);
   }
   // |d_f'| <= K_f (a top that is not spherical: |w x u| <= max |w(t)|)
   double rate_bound(int f) const {
     const Vec3 u = axes.col(f >> 1);
     const double wu = motion.spherical() ? st.w.cross(u).norm() : motion.max_angular_speed();
-    return std::abs(st.v.dot(u)) + wu * L;
+    return std::abs(st.v.dot(u)) + wu * L * smax + std::abs(sdot) * L;
   }
 };
 
 template <SupportShape S>
 EscapeResult escape_time(const EscapeInput<S>& in, const EscapeOptions& o = {}) {
   EscapeResult out;
-  const BoxDistance<S> D(in.shape, in.body, in.t_state, in.box, in.margin);
+  const BoxDistance<S> D(in.shape, in.body, in.t_state, in.box, in.margin, in.scale,
+                         in.scale_rate, in.t_max);
   std::array<double, 6> K, d0, d1;
   double kmax = 0.0;
   for (int f = 0; f < 6; ++f) kmax = std::max(kmax, K[f] = D.rate_bound(f));

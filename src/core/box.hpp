@@ -1,5 +1,8 @@
-// Periodic orthorhombic box [0, L) with minimum-image convention.
+// Orthorhombic box [0, L) with the minimum-image convention along its periodic axes. An axis
+// that is not periodic is bounded by hard walls at 0 and L (locals/walls.hpp): separations along
+// it are never wrapped, and positions along it stay in [0, L] because the walls keep them there.
 #pragma once
+#include <array>
 #include <cmath>
 
 #include "math/types.hpp"
@@ -8,27 +11,34 @@ namespace hb {
 
 struct Box {
   Vec3 L = Vec3::Ones();
+  std::array<bool, 3> periodic{true, true, true};
 
   double volume() const { return L.x() * L.y() * L.z(); }
+  bool fully_periodic() const { return periodic[0] && periodic[1] && periodic[2]; }
+  Vec3 centre() const { return 0.5 * L; }
 
   // Minimum image of a separation vector; valid for any |d| (not only |d| < 1.5 L).
   Vec3 minimum_image(Vec3 d) const {
-    for (int k = 0; k < 3; ++k) d[k] -= L[k] * std::nearbyint(d[k] / L[k]);
+    for (int k = 0; k < 3; ++k)
+      if (periodic[k]) d[k] -= L[k] * std::nearbyint(d[k] / L[k]);
     return d;
   }
   // Minimum image by repeated subtraction: exact for any d, and one compare per axis in the
   // usual case of centres stored inside or near the box (no division). Hot path of prediction.
   Vec3 near_image(Vec3 d) const {
     for (int k = 0; k < 3; ++k) {
+      if (!periodic[k]) continue;
       while (d[k] > 0.5 * L[k]) d[k] -= L[k];
       while (d[k] < -0.5 * L[k]) d[k] += L[k];
     }
     return d;
   }
-  // Wrap a position into [0, L); returns the image shift applied (in box lengths).
+  // Wrap a position into [0, L) along the periodic axes; returns the image shift applied (in box
+  // lengths).
   Eigen::Vector3i wrap(Vec3& r) const {
     Eigen::Vector3i shift(0, 0, 0);
     for (int k = 0; k < 3; ++k) {
+      if (!periodic[k]) continue;
       const double s = std::floor(r[k] / L[k]);
       if (s != 0.0) {
         r[k] -= s * L[k];

@@ -12,8 +12,10 @@ enum class EventType : std::uint8_t {
   CellCross = 2,  // owner leaves its cell through face `partner` (0..5 = -x,+x,-y,+y,-z,+z)
   Rebuild = 3,    // owner's neighbour-list box must be rebuilt
   Recheck = 4,    // nothing physical: re-predict the owner at this time (bounded search window)
+  Wall = 5,       // owner hits wall `partner` (planar walls: box face 0..5 = -x,+x,-y,+y,-z,+z)
+  Thermostat = 6, // owner's velocities are redrawn (Andersen thermostat)
 };
-inline constexpr int kEventTypes = 5;
+inline constexpr int kEventTypes = 7;
 inline const char* event_name(EventType t) {
   switch (t) {
     case EventType::None: return "none";
@@ -21,6 +23,8 @@ inline const char* event_name(EventType t) {
     case EventType::CellCross: return "cell_crossing";
     case EventType::Rebuild: return "nnl_rebuild";
     case EventType::Recheck: return "recheck";
+    case EventType::Wall: return "wall";
+    case EventType::Thermostat: return "thermostat";
   }
   return "unknown";
 }

@@ -96,6 +96,12 @@ ConfigSignature config_signature(const Config& c) {
   w.add("neighbors.method", c.neighbors_method == "cells" ? 0 : 1);
   w.add("neighbors.shell", c.shell);
   w.add("solver.eps_d", c.eps_d);
+  for (int k = 0; k < 3; ++k) w.add(fmt::format("box.aspect[{}]", k), c.boundaries.aspect[k]);
+  for (int k = 0; k < 3; ++k) w.add(fmt::format("walls.planes[{}]", k), c.boundaries.walls.planes[k] ? 1.0 : 0.0);
+  w.add("walls.sphere", c.boundaries.walls.sphere_radius);
+  w.add("thermostat.type", double(int(c.thermostat.type)));
+  w.add("thermostat.rate", c.thermostat.rate);
+  w.add("thermostat.during", double(int(c.thermostat.during)));
   // The keys that shape the measured stretch and its summary: a resume that changed one would
   // describe a different run (run.time and run.max_collisions may grow: that extends the run).
   w.add("run.equilibrate_time", c.equilibrate_time);
@@ -186,10 +192,11 @@ void add_checkpoint_sources(gsd::FrameSource& f, const State& s, LoopSnapshot lo
   f.log[key("best")] = event_rows(loop, &LoopSnapshot::best);
   std::vector<double> l{loop->now, double(loop->stale)};
   for (auto x : loop->counts) l.push_back(double(x));
+  l.push_back(double(loop->rescheduled));
   f.log["hardbody/loop"] = record(l);
   std::vector<double> dr{double(d.phase), d.e0, d.coll0, d.stale0, double(d.log_rows),
                          double(d.frames), d.next_snapshot, d.block_start, d.cpu_prev, d.wall_prev,
-                         d.next_corr, d.next_gr};
+                         d.next_corr, d.next_gr, d.rescheduled0};
   dr.insert(dr.end(), d.events0.begin(), d.events0.end());
   f.log["hardbody/driver"] = record(dr);
   f.log["hardbody/pressure"] = record(d.pressure);
@@ -199,6 +206,10 @@ void add_checkpoint_sources(gsd::FrameSource& f, const State& s, LoopSnapshot lo
   f.log["hardbody/pair_collisions"] = record(d.pair_collisions);
   f.log["hardbody/obs_gr_partial"] = record(d.gr_partial);
   f.log["hardbody/obs_temperatures"] = record(d.temperatures);
+  f.log["hardbody/obs_wall_pressure"] = record(d.wall_pressure);
+  f.log["hardbody/obs_profiles"] = record(d.profiles);
+  f.log["hardbody/thermostat_next"] = record(d.thermostat_next);
+  f.log["hardbody/thermostat_count"] = record(d.thermostat_count);
   for (std::size_t a = 0; a < d.corr_species.size(); ++a)
     f.log[fmt::format("hardbody/obs_correlations_species{}", a)] = record(d.corr_species[a]);
   f.log["hardbody/config"] = record(config_signature(c).values);
@@ -316,18 +327,20 @@ void read_core(const Reader& r, Box& box, State& s, LoopSnapshot& loop, DriverSt
   loop.slot = r.events(key("calendar"), n);
   loop.best = r.events(key("best"), n);
   const auto l = r.row("hardbody/loop");
-  if (l.size() != 2 + kEventTypes) throw InputError(fmt::format("{}: bad loop record", r.path));
+  if (l.size() != 3 + kEventTypes) throw InputError(fmt::format("{}: bad loop record", r.path));
   loop.now = l[0];
   loop.stale = std::uint64_t(l[1]);
   for (int k = 0; k < kEventTypes; ++k) loop.counts[k] = std::uint64_t(l[2 + k]);
+  loop.rescheduled = std::uint64_t(l[2 + kEventTypes]);
   const auto dr = r.row("hardbody/driver");
-  if (dr.size() != 12 + kEventTypes) throw InputError(fmt::format("{}: bad driver record", r.path));
+  if (dr.size() != 13 + kEventTypes) throw InputError(fmt::format("{}: bad driver record", r.path));
   d.phase = int(dr[0]);
   d.e0 = dr[1], d.coll0 = dr[2], d.stale0 = dr[3];
   d.log_rows = std::uint64_t(dr[4]), d.frames = std::uint64_t(dr[5]);
   d.next_snapshot = dr[6], d.block_start = dr[7], d.cpu_prev = dr[8], d.wall_prev = dr[9];
   d.next_corr = dr[10], d.next_gr = dr[11];
-  for (int k = 0; k < kEventTypes; ++k) d.events0[k] = dr[12 + k];
+  d.rescheduled0 = dr[12];
+  for (int k = 0; k < kEventTypes; ++k) d.events0[k] = dr[13 + k];
   // rows of length 1 holding 0 stand for empty records (GSD chunks need at least one value)
   auto record = [&](const char* k) {
     auto v = r.row(k);
@@ -341,6 +354,13 @@ void read_core(const Reader& r, Box& box, State& s, LoopSnapshot& loop, DriverSt
   d.pair_collisions = record("hardbody/pair_collisions");
   d.gr_partial = record("hardbody/obs_gr_partial");
   d.temperatures = record("hardbody/obs_temperatures");
+  auto optional_record = [&](const char* k) {
+    return r.f.log.count(k) ? record(k) : std::vector<double>{};
+  };
+  d.wall_pressure = optional_record("hardbody/obs_wall_pressure");
+  d.profiles = optional_record("hardbody/obs_profiles");
+  d.thermostat_next = optional_record("hardbody/thermostat_next");
+  d.thermostat_count = optional_record("hardbody/thermostat_count");
   d.corr_species.clear();
   for (std::size_t a = 0; r.f.log.count(fmt::format("hardbody/obs_correlations_species{}", a)); ++a)
     d.corr_species.push_back(record(fmt::format("hardbody/obs_correlations_species{}", a).c_str()));

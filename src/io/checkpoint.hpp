@@ -24,7 +24,7 @@ namespace hb {
 // What the run driver accumulates (checkpointed with the state).
 struct DriverState {
   int phase = 0;  // 0 equilibrating, 1 measuring, 2 done
-  double e0 = 0.0, coll0 = 0.0, stale0 = 0.0;
+  double e0 = 0.0, coll0 = 0.0, stale0 = 0.0, rescheduled0 = 0.0;
   std::array<double, kEventTypes> events0{};
   std::uint64_t log_rows = 0, frames = 0;
   double next_snapshot = 0.0, block_start = 0.0;
@@ -36,6 +36,10 @@ struct DriverState {
   std::vector<double> temperatures;        // SpeciesTemperatures::save()
   std::vector<std::vector<double>> corr_species;  // TimeCorrelations::save() per species (mixtures)
   std::vector<double> pair_collisions;     // measured collisions per species pair a <= b (row-major upper triangle)
+  std::vector<double> wall_pressure;       // WallPressure::save() (walls)
+  std::vector<double> profiles;            // DensityProfiles::save() (walls)
+  std::vector<double> thermostat_next;     // AndersenThermostat: each body's next event time
+  std::vector<double> thermostat_count;    //   and its event count
 };
 
 // A copy of the state with every body streamed to the current time and wrapped into the box.

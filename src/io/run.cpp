@@ -26,6 +26,7 @@
 #include "observers/correlations.hpp"
 #include "observers/structure.hpp"
 #include "observers/thermo.hpp"
+#include "observers/wall_observables.hpp"
 #include "setup/builder.hpp"
 
 namespace hb {
@@ -192,6 +193,13 @@ class Driver {
     if (!st_.temperatures.empty()) temps_.load(st_.temperatures);
     const std::size_t ns = cfg_.species.size();
     st_.pair_collisions.resize(ns * (ns + 1) / 2, 0.0);
+    const WallSpec& walls = cfg_.boundaries.walls;
+    if (walls.any()) {
+      wall_pressure_.emplace(wall_area(walls, sim_.box()));
+      profiles_.emplace(walls, sim_.box(), profile_species(cfg_.species), default_profile_bin(cfg_.species));
+      if (!st_.wall_pressure.empty()) wall_pressure_->load(st_.wall_pressure);
+      if (!st_.profiles.empty()) profiles_->load(st_.profiles);
+    }
   }
 
   static CorrelationSpec correlation_spec(const Config& c) {
@@ -240,6 +248,7 @@ class Driver {
         st_.e0 = energy();
         st_.coll0 = double(sim_.collisions());
         st_.stale0 = double(sim_.stale_events());
+        st_.rescheduled0 = double(sim_.rescheduled_events());
         for (int k = 0; k < kEventTypes; ++k) st_.events0[k] = double(sim_.event_counts()[k]);
         st_.block_start = sim_.now();
         st_.next_snapshot = sim_.now();
@@ -247,27 +256,41 @@ class Driver {
         st_.next_gr = sim_.now();
         cpu_mark_ = cpu_seconds();
         wall_mark_ = progress_.wall_seconds();
+        if (cfg_.thermostat.during == ThermostatSpec::During::equilibration) sim_.set_thermostat(false);
       }
-      if (st_.phase == 1 && writer && sim_.now() >= st_.next_snapshot) {
-        writer->write_frame(make_frame(sim_, cfg_.species, false, nullptr));
-        writer->sync();
-        st_.frames += 1;
+      // snapshots: a trajectory frame (if written), the independent checks and, with walls, the
+      // profiles (sampled on the snapshot grid even without a trajectory)
+      if (st_.phase == 1 && (writer || profiles_) && sim_.now() >= st_.next_snapshot) {
+        if (writer) {
+          writer->write_frame(make_frame(sim_, cfg_.species, false, nullptr));
+          writer->sync();
+          st_.frames += 1;
+        }
         st_.next_snapshot += cfg_.snapshot_interval;
         // every snapshot is also checked for overlaps by the independent test
-        const auto rep = ops_.overlaps(synchronized_state(sim_), sim_.box());
+        const State snap = synchronized_state(sim_);
+        const auto rep = ops_.overlaps(snap, sim_.box());
         snapshot_overlaps_ += rep.overlaps;
         snapshot_min_gap_ = std::min(snapshot_min_gap_, rep.min_distance);
+        if (profiles_) {
+          profiles_->sample(sim_.now(), snap, sim_.box());
+          const double pen = wall_penetration(snap);
+          worst_wall_penetration_ = std::max(worst_wall_penetration_, pen);
+          if (pen > 0.0) ++snapshot_wall_penetrations_;
+        }
       }
       if (st_.phase == 1) sample_observables();
       const double block_end = st_.phase == 0 ? t_eq : log_block_end(st_.block_start, t_end);
       double target = block_end;
-      if (st_.phase == 1 && writer) target = std::min(target, st_.next_snapshot);
+      if (st_.phase == 1 && (writer || profiles_)) target = std::min(target, st_.next_snapshot);
       if (st_.phase == 1 && cfg_.obs_interval > 0.0) target = std::min(target, st_.next_corr);
       if (st_.phase == 1 && cfg_.gr_interval > 0.0) target = std::min(target, st_.next_gr);
       bool limit = false;
       for (;;) {
         const StepInfo s = sim_.step(target);
         if (s.type == EventType::None) break;
+        if (st_.phase == 1 && s.type == EventType::Wall && wall_pressure_)
+          wall_pressure_->add(s.record.time, s.record.J);
         if (st_.phase == 1 && s.type == EventType::Collision && !s.stale) {
           pressure_.on_collision(s.record);
           count_pair(s.record);
@@ -283,6 +306,7 @@ class Driver {
       if (st_.phase == 1 && (sim_.now() >= block_end || limit)) {
         const double kT = temperature();
         pressure_.close_block(sim_.now() - st_.block_start, kT, n);
+        if (wall_pressure_) wall_pressure_->close_block(sim_.now() - st_.block_start, kT);
         st_.block_start = sim_.now();
         if (!all_spheres()) nem_.sample(sim_.now() - t_eq, synchronized_state(sim_), sim_.box());
         temps_.sample(species_temperatures(synchronized_state(sim_)));
@@ -351,6 +375,13 @@ class Driver {
     st_.gr = rdf_.save();
     st_.nematic = nem_.save();
     st_.temperatures = temps_.save();
+    if (wall_pressure_) st_.wall_pressure = wall_pressure_->save();
+    if (profiles_) st_.profiles = profiles_->save();
+    {
+      const AndersenThermostat& th = sim_.body_events().thermostat();
+      st_.thermostat_next = th.next_times();
+      st_.thermostat_count.assign(th.counts().begin(), th.counts().end());
+    }
     if (partial_gr()) st_.gr_partial = gr_partial_.save();
     st_.corr_species.clear();
     for (const auto& c : corr_species_) st_.corr_species.push_back(c.save());
@@ -542,12 +573,41 @@ class Driver {
     j["momentum_drift"] = p.norm() / p_scale;
     j["overlaps"] = rep.overlaps;
     j["min_distance"] = rep.min_distance;
+    if (wall_pressure_) {
+      const MeanError wp = wall_pressure_->pressure();
+      j["wall_pressure"] = wp.mean;
+      j["wall_pressure_error"] = wp.error;  // NaN -> null: fewer than 2 log blocks
+      // the independent check of every snapshot and the final state: the support-function
+      // distance of each body to each wall (> 0: through it)
+      worst_wall_penetration_ = std::max(worst_wall_penetration_, wall_penetration(st));
+      j["wall_penetrations"] = snapshot_wall_penetrations_ + (wall_penetration(st) > 0.0 ? 1 : 0);
+      j["max_wall_penetration"] = worst_wall_penetration_;
+      // hard spheres of one size: the contact value of the centre density (the contact theorem
+      // says beta P_wall = rho(sigma / 2) at a planar wall)
+      if (const Sphere* sph = std::get_if<Sphere>(&cfg_.one().shape);
+          sph && cfg_.species.size() == 1 && !cfg_.one().poly.active() && cfg_.boundaries.walls.any_plane() &&
+          profiles_->samples() > 0) {
+        const int k = cfg_.boundaries.walls.planes[2] ? 2 : cfg_.boundaries.walls.planes[1] ? 1 : 0;
+        try {
+          const ContactValue cv = contact_density(*profiles_, "xyz"[k], sph->radius);
+          j["wall_contact_density"] = cv.density;
+          j["wall_contact_density_error"] = cv.error;
+        } catch (const std::invalid_argument&) {  // too few bins beyond contact: not reported
+        }
+      }
+      write_file_atomic(dir_ + "/density_profile.tsv", profiles_->to_tsv());
+      if (profiles_->has_order()) write_file_atomic(dir_ + "/order_profile.tsv", profiles_->order_tsv());
+    }
+    if (cfg_.thermostat.active())
+      j["thermostat"] = {{"type", "andersen"}, {"rate", cfg_.thermostat.rate},
+                         {"during", cfg_.thermostat.during == ThermostatSpec::During::always ? "always" : "equilibration"}};
     nlohmann::json ev;
     const auto& events = sim_.event_counts();
     for (int k = 1; k < kEventTypes; ++k)
       if (events[k] > 0 || k == int(EventType::Collision))
         ev[event_name(EventType(k))] = double(events[k]) - st_.events0[k];
     ev["stale"] = double(sim_.stale_events()) - st_.stale0;
+    ev["rescheduled"] = double(sim_.rescheduled_events()) - st_.rescheduled0;
     j["events"] = ev;
     j["solver_fallbacks"] = 0;
     if constexpr (requires { sim_.model().stats; }) {
@@ -633,6 +693,26 @@ class Driver {
   double cpu_mark_ = 0.0, wall_mark_ = 0.0, last_checkpoint_ = 0.0;
   std::uint64_t snapshot_overlaps_ = 0;
   double snapshot_min_gap_ = kInf;
+  std::optional<WallPressure> wall_pressure_;  // with walls
+  std::optional<DensityProfiles> profiles_;    // with walls
+  std::uint64_t snapshot_wall_penetrations_ = 0;
+  double worst_wall_penetration_ = -kInf;
+
+  // The deepest penetration of a body into a wall in a synchronised state (support-function
+  // distance, > 0 through the wall; -inf without walls).
+  double wall_penetration(const State& s) const {
+    double worst = -kInf;
+    if constexpr (requires { Sim::model_type::kBodyEvents; }) {
+      const Box& box = sim_.box();
+      for (std::uint32_t i = 0; i < s.size(); ++i)
+        sim_.model().visit_body(s, i, sim_.now(), [&](const auto& shape, const MassProperties&, const BodyGrowth& g, double) {
+          for (int f = 0; f < 6; ++f)
+            if (!box.periodic[f >> 1])
+              worst = std::max(worst, -PlanarWalls::distance(shape, s.body(i), g.s, box, f));
+        });
+    }
+    return worst;
+  }
 };
 
 // Writes the checkpoint of a stopping run and says what happened to it (a failed write, e.g. a
@@ -795,7 +875,15 @@ void start_or_resume_in(const Config& cfg, const RunOptions& opt, const std::str
       return;
     }
     auto r = read_checkpoint<typename A::neighbors_type>(ck, cfg);
-    auto sim = as.restore(r.box, std::move(r.state), r.neighbors, r.loop);
+    r.box.periodic = box_for(cfg).periodic;  // the walls are the config's
+    std::optional<AndersenThermostat> th;
+    if (cfg.thermostat.active()) {
+      th.emplace(as.body_events().thermostat());
+      std::vector<std::uint64_t> counts(r.driver.thermostat_count.begin(), r.driver.thermostat_count.end());
+      if (r.driver.thermostat_next.size() == r.state.size()) th->restore(r.driver.thermostat_next, counts);
+      if (r.driver.phase >= 1 && cfg.thermostat.during == ThermostatSpec::During::equilibration) th->set_on(false);
+    }
+    auto sim = as.restore(r.box, std::move(r.state), r.neighbors, r.loop, th ? &*th : nullptr);
     check_restored(sim, as.ops(), ck);
     const double t_ck = sim.now() - cfg.equilibrate_time;  // measured time reached
     if (r.driver.phase >= 1 && t_ck > cfg.time)
@@ -823,6 +911,7 @@ void start_or_resume_in(const Config& cfg, const RunOptions& opt, const std::str
   // function of the config).
   write_file_atomic(dir + "/config.resolved.toml", to_toml(cfg));
   Start start = make_start(cfg, opt, dir, as);
+  start.box.periodic = box_for(cfg).periodic;  // the walls are the config's (a file start too)
   auto sim = as.simulate(start.box, std::move(start.state));
   {
     const auto rep = as.ops().overlaps(sim.state(), sim.box());

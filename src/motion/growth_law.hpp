@@ -29,4 +29,11 @@ inline double growth_normal_speed(double s, double sdot, const Vec3& n, const Ve
   return std::max(0.0, (sdot / s) * n.dot(r_ab));
 }
 
+// The growth of one body as a single-body event source sees it (system/body_events.hpp): its
+// scale s at the prediction time and ds/dt (1 and 0 for a rigid body).
+struct BodyGrowth {
+  double s = 1.0;
+  double rate = 0.0;
+};
+
 }  // namespace hb

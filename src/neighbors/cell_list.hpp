@@ -1,6 +1,8 @@
-// Linked cell lists over the periodic box: cells at least `min_width` wide, so bodies that can
-// touch sit in the same or adjacent cells (27-cell stencil). Bodies change cell only through
-// cell-crossing events, which the caller schedules from crossing_time().
+// Linked cell lists over the box: cells at least `min_width` wide, so bodies that can touch sit
+// in the same or adjacent cells (27-cell stencil). Bodies change cell only through cell-crossing
+// events, which the caller schedules from crossing_time(). Along an axis that is not periodic
+// (hard walls at 0 and L) the stencil stops at the first and last cells instead of wrapping, and
+// the outer faces of those cells are never crossed.
 #pragma once
 #include <algorithm>
 #include <array>
@@ -37,15 +39,20 @@ class CellList {
   static constexpr std::uint32_t kNone = 0xffffffffu;
 
   CellList() = default;
-  CellList(const Vec3& L, double min_width, std::size_t n_bodies) { init(L, min_width, n_bodies); }
+  CellList(const Vec3& L, double min_width, std::size_t n_bodies,
+           std::array<bool, 3> periodic = {true, true, true}) {
+    init(L, min_width, n_bodies, periodic);
+  }
 
-  void init(const Vec3& L, double min_width, std::size_t n_bodies) {
+  void init(const Vec3& L, double min_width, std::size_t n_bodies,
+            std::array<bool, 3> periodic = {true, true, true}) {
+    periodic_ = periodic;
     const double w = capped_cell_width(L, min_width, n_bodies);
     auto count = [&](int k) { return std::floor(L[k] / w); };
     for (int k = 0; k < 3; ++k) {
       int nc = static_cast<int>(std::max(1.0, count(k)));
-      // With fewer than 3 cells the stencil would wrap onto itself; use one cell then.
-      if (nc < 3) nc = 1;
+      // With fewer than 3 cells a periodic stencil would wrap onto itself; use one cell then.
+      if (nc < 3 && periodic_[k]) nc = 1;
       nc_[k] = nc;
       width_[k] = L[k] / nc;
     }
@@ -57,6 +64,7 @@ class CellList {
   }
 
   const std::array<int, 3>& dims() const { return nc_; }
+  const std::array<bool, 3>& periodic() const { return periodic_; }
   const Vec3& width() const { return width_; }
   std::size_t n_cells() const { return head_.size(); }
   std::uint32_t cell_of(std::uint32_t i) const { return cell_[i]; }
@@ -100,6 +108,7 @@ class CellList {
     std::array<int, 3> c = coord_[i];
     c[k] += (face & 1) ? 1 : -1;
     const bool wrapped = c[k] < 0 || c[k] >= nc_[k];
+    if (!periodic_[k] && wrapped) throw std::logic_error("cell crossing through a wall");
     c[k] = wrap(c[k], k);
     remove(i);
     place(i, c);
@@ -116,9 +125,11 @@ class CellList {
       double t;
       int f;
       if (v[k] > 0.0) {
+        if (!periodic_[k] && coord_[i][k] == nc_[k] - 1) continue;  // the wall's side
         t = ((coord_[i][k] + 1) * width_[k] - r[k]) / v[k];
         f = 2 * k + 1;
       } else if (v[k] < 0.0) {
+        if (!periodic_[k] && coord_[i][k] == 0) continue;
         t = (coord_[i][k] * width_[k] - r[k]) / v[k];
         f = 2 * k;
       } else {
@@ -130,9 +141,13 @@ class CellList {
     return best;
   }
 
-  // True when some axis has a single cell: then the stencil cannot tell periodic images apart
-  // and callers must apply the minimum-image convention themselves.
-  bool needs_minimum_image() const { return nc_[0] == 1 || nc_[1] == 1 || nc_[2] == 1; }
+  // True when some periodic axis has a single cell: then the stencil cannot tell periodic images
+  // apart and callers must apply the minimum-image convention themselves.
+  bool needs_minimum_image() const {
+    for (int k = 0; k < 3; ++k)
+      if (nc_[k] == 1 && periodic_[k]) return true;
+    return false;
+  }
 
   // Calls fn(j, shift) for every body j in the 27 cells around body i's cell (including i
   // itself); `shift` is the periodic image offset to add to j's position to place it next to i
@@ -168,7 +183,8 @@ class CellList {
 
  private:
   // Visit the cells c + d for d in [lo, hi] (per axis), wrapping periodically and telling fn
-  // the image shift of each cell.
+  // the image shift of each cell; along an axis that is not periodic, cells beyond the ends are
+  // left out.
   template <class Fn>
   void visit(const std::array<int, 3>& c, const std::array<int, 3>& lo,
              const std::array<int, 3>& hi, const Vec3& L, Fn& fn) const {
@@ -188,13 +204,17 @@ class CellList {
   }
   int axis(int c, int lo, int hi, int k, double L, int* out, double* shift) const {
     int n = 0;
-    for (int d = lo; d <= hi; ++d, ++n) {
+    for (int d = lo; d <= hi; ++d) {
       int x = c + d;
       double s = 0.0;
-      if (x < 0) x += nc_[k], s = -L;
-      else if (x >= nc_[k]) x -= nc_[k], s = L;
+      if (x < 0 || x >= nc_[k]) {
+        if (!periodic_[k]) continue;
+        if (x < 0) x += nc_[k], s = -L;
+        else x -= nc_[k], s = L;
+      }
       out[n] = x;
       shift[n] = s;
+      ++n;
     }
     return n;
   }
@@ -210,6 +230,7 @@ class CellList {
   }
 
   std::array<int, 3> nc_{1, 1, 1};
+  std::array<bool, 3> periodic_{true, true, true};
   Vec3 width_ = Vec3::Ones();
   std::vector<std::uint32_t> head_, next_, prev_, cell_;
   std::vector<std::array<int, 3>> coord_;

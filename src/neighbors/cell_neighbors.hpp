@@ -17,7 +17,7 @@ class CellNeighbors {
   explicit CellNeighbors(double range = 1.0) : range_(range) {}
 
   void init(const Box& box, State& s, double now) {
-    cells_.init(box.L, range_, s.size());
+    cells_.init(box.L, range_, s.size(), box.periodic);
     for (std::uint32_t i = 0; i < s.size(); ++i) {
       s.advance_to(i, now);
       s.image[i] += box.wrap(s.r[i]);
@@ -27,7 +27,7 @@ class CellNeighbors {
   // Restore: bodies are placed in the given cells (positions are not streamed or re-binned,
   // since a body that just crossed a face sits on it and binning could pick the other side).
   void restore(const Box& box, const State& s, const std::vector<std::array<int, 3>>& coords) {
-    cells_.init(box.L, range_, s.size());
+    cells_.init(box.L, range_, s.size(), box.periodic);
     for (std::uint32_t i = 0; i < s.size(); ++i) cells_.place_at(i, coords[i]);
   }
   std::vector<std::array<int, 3>> snapshot() const {

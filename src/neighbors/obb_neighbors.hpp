@@ -256,7 +256,7 @@ class ObbNeighbors {
     const double rho = double(n) / box.volume();
     const double expect = rho * 4.18879 * reach * reach * reach;  // centres within 2 rc
     lists_.init(n, static_cast<std::uint32_t>(std::min<double>(expect + 16, double(n))));
-    cells_.init(box.L, reach, n);
+    cells_.init(box.L, reach, n, box.periodic);
     obb_.assign(n, Obb{});
     q_.assign(n, Quat::Identity());
   }

@@ -72,7 +72,7 @@ class ShellNeighbors {
     // expected partners rho * 4/3 pi reach^3, with room for fluctuations
     const double rho = double(n) / box.volume();
     lists_.init(n, static_cast<std::uint32_t>(2.0 * rho * 4.18879 * reach * reach * reach) + 16);
-    cells_.init(box.L, reach, n);
+    cells_.init(box.L, reach, n, box.periodic);
     centre_.resize(n);
     for (std::uint32_t i = 0; i < n; ++i) {
       s.advance_to(i, now);
@@ -97,7 +97,7 @@ class ShellNeighbors {
     const double reach = range_ + delta_, reach2 = reach * reach;
     const double rho = double(n) / box.volume();
     lists_.init(n, static_cast<std::uint32_t>(2.0 * rho * 4.18879 * reach * reach * reach) + 16);
-    cells_.init(box.L, reach, n);
+    cells_.init(box.L, reach, n, box.periodic);
     centre_ = centres;
     for (std::uint32_t i = 0; i < n; ++i) cells_.insert(i, centre_[i]);
     for (std::uint32_t i = 0; i < n; ++i)

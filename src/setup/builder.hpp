@@ -30,6 +30,7 @@
 #include "neighbors/obb_neighbors.hpp"
 #include "neighbors/shell_neighbors.hpp"
 #include "observers/overlap_check.hpp"
+#include "setup/box_setup.hpp"
 #include "setup/config.hpp"
 #include "setup/growth.hpp"
 #include "setup/init.hpp"
@@ -102,6 +103,19 @@ HardSphereMixture plan_sphere_mixture(const Config& c);  // several species or p
 RigidSystemSpec plan_rigid(const Config& c);           // one species of non-spherical bodies
 RigidMixture plan_rigid_mixture(const Config& c);      // any other mixture or polydispersity
 
+// The single-body event sources of a config (system/body_events.hpp): hard planar walls on the
+// axes of walls.planes (grazing step solver.eps_d) and the Andersen thermostat of [thermostat]
+// (seeded by system.seed).
+inline BodyEvents body_events_for(const Config& c) {
+  AndersenThermostat th;
+  if (c.thermostat.active()) th = AndersenThermostat(c.thermostat.rate, c.temperature, c.seed);
+  return BodyEvents(PlanarWalls(c.boundaries.walls.planes, c.eps_d), std::move(th));
+}
+// A box that is not the default periodic cube: the starts grow the bodies in box_for(c).
+inline bool bounded(const Config& c) {
+  return c.boundaries.walls.any() || c.boundaries.aspect != Vec3::Ones();
+}
+
 template <class Model, class Neighbors>
 class Assembly {
  public:
@@ -109,20 +123,26 @@ class Assembly {
   using neighbors_type = Neighbors;
   using StartFn = std::function<Start(const StartOptions&)>;
 
-  Assembly(Model model, Neighbors nb, SystemOps ops, StartFn start)
-      : model_(std::move(model)), nb_(std::move(nb)), ops_(std::move(ops)), start_(std::move(start)) {}
+  Assembly(Model model, Neighbors nb, SystemOps ops, StartFn start, BodyEvents events = {})
+      : model_(std::move(model)), nb_(std::move(nb)), ops_(std::move(ops)), start_(std::move(start)),
+        events_(std::move(events)) {}
 
   const SystemOps& ops() const { return ops_; }
   const Model& model() const { return model_; }
+  const BodyEvents& body_events() const { return events_; }
   Start start(const StartOptions& opt = {}) const { return start_(opt); }
   Sim simulate(const Box& box, State st, double now = 0.0) const {
-    return Sim(box, std::move(st), model_, nb_, now);
+    return Sim(box, std::move(st), model_, nb_, now, events_);
   }
+  // thermostat: the thermostat's saved state (next event times, event counts), if it has one.
   template <class NbSnapshot>
-  Sim restore(const Box& box, State st, const NbSnapshot& nb_snapshot, const LoopSnapshot& loop) const {
+  Sim restore(const Box& box, State st, const NbSnapshot& nb_snapshot, const LoopSnapshot& loop,
+              const AndersenThermostat* thermostat = nullptr) const {
     Neighbors nb = nb_;
     nb.restore(box, st, nb_snapshot);
-    return Sim(box, std::move(st), model_, std::move(nb), loop);
+    BodyEvents ev = events_;
+    if (thermostat) ev.thermostat() = *thermostat;
+    return Sim(box, std::move(st), model_, std::move(nb), loop, std::move(ev));
   }
 
  private:
@@ -130,6 +150,7 @@ class Assembly {
   Neighbors nb_;
   SystemOps ops_;
   StartFn start_;
+  BodyEvents events_;
 };
 
 namespace builder_detail {
@@ -150,6 +171,34 @@ inline Start grown_start(GrowthResult result, const GrowthOptions& go, const Ove
   s.box = s.info.result.box;
   s.state = std::move(s.info.result.state);
   return s;
+}
+
+// The start of a bounded box (walls, side ratios): random placement at init.phi0 (clear of the
+// walls) in box_for(c), then growth with the walls in place, checked by `check`.
+inline Start bounded_start(const Config& c, const OverlapCheck& check, const StartOptions& opt) {
+  GrowthOptions g;
+  g.rate = c.init_growth_rate;
+  g.phi0 = std::min(c.init_phi0, c.packing_fraction);
+  g.kT = c.temperature;
+  g.box = box_for(c);
+  g.wall_eps = c.eps_d;
+  g.report = opt.growth_report;
+  bool spheres = true;
+  for (const Species& sp : c.species) spheres = spheres && std::holds_alternative<Sphere>(sp.shape);
+  if (!opt.quiet)
+    std::fprintf(stderr, "hardbody: placing at phi = %g in a %.4g x %.4g x %.4g box, growing to %g (rate %g) ...\n",
+                 g.phi0, g.box->L.x(), g.box->L.y(), g.box->L.z(), c.packing_fraction, g.rate);
+  GrowthResult r = spheres ? grow_sphere_mixture(c.species, c.packing_fraction, c.seed, g)
+                           : grow_rigid_mixture(c.species, c.packing_fraction, c.seed, g, c.eps_d);
+  GrowthOptions info = g;
+  info.report = nullptr;
+  return grown_start(std::move(r), info, check, c.seed);
+}
+// The start function of an assembly: `start` for the periodic cube, bounded_start otherwise.
+template <class StartFn>
+std::function<Start(const StartOptions&)> start_for(const Config& c, const SystemOps& ops, StartFn start) {
+  if (!bounded(c)) return start;
+  return [c, check = ops.overlaps](const StartOptions& opt) { return bounded_start(c, check, opt); };
 }
 
 template <class F>
@@ -174,7 +223,7 @@ void assemble_spheres(const Config& c, F&& f) {
       g.report = opt.growth_report;
       return grown_start(grow_sphere_mixture(species, phi, seed, g), go, check, seed);
     };
-    f(Assembly<HardSphereMixture, CellNeighbors>(model, CellNeighbors(model.interaction_range()), ops, start));
+    f(Assembly<HardSphereMixture, CellNeighbors>(model, CellNeighbors(model.interaction_range()), ops, start_for(c, ops, start), body_events_for(c)));
     return;
   }
   // one species: the monomorphic fast path
@@ -202,9 +251,9 @@ void assemble_spheres(const Config& c, F&& f) {
   };
   const HardSpheres model{spec.sigma, spec.mass};
   if (spec.shell > 0.0)
-    f(Assembly<HardSpheres, ShellNeighbors>(model, ShellNeighbors(spec.sigma, spec.shell), ops, start));
+    f(Assembly<HardSpheres, ShellNeighbors>(model, ShellNeighbors(spec.sigma, spec.shell), ops, start_for(c, ops, start), body_events_for(c)));
   else
-    f(Assembly<HardSpheres, CellNeighbors>(model, CellNeighbors(spec.sigma), ops, start));
+    f(Assembly<HardSpheres, CellNeighbors>(model, CellNeighbors(spec.sigma), ops, start_for(c, ops, start), body_events_for(c)));
 }
 
 // The unit body of the lattice start: the shape with unit semi-axes.
@@ -259,9 +308,9 @@ void assemble_rigid(const Config& c, const S& shape, F&& f) {
     return s;
   };
   if (c.neighbors_method == "nnl")
-    f(Assembly<RigidBodies<S>, ObbNeighbors<S>>(model, ObbNeighbors<S>(shape, c.shell), ops, start));
+    f(Assembly<RigidBodies<S>, ObbNeighbors<S>>(model, ObbNeighbors<S>(shape, c.shell), ops, start_for(c, ops, start), body_events_for(c)));
   else
-    f(Assembly<RigidBodies<S>, CellNeighbors>(model, CellNeighbors(model.interaction_range()), ops, start));
+    f(Assembly<RigidBodies<S>, CellNeighbors>(model, CellNeighbors(model.interaction_range()), ops, start_for(c, ops, start), body_events_for(c)));
 }
 
 // Mixtures with non-spherical species, and polydisperse non-spherical bodies: the generic
@@ -286,9 +335,9 @@ void assemble_rigid_mixture(const Config& c, F&& f) {
   };
   if (c.neighbors_method == "nnl")
     f(Assembly<RigidMixture, ObbNeighbors<AnyShape>>(
-        model, ObbNeighbors<AnyShape>(model.shape, model.max_scale, c.shell), ops, start));
+        model, ObbNeighbors<AnyShape>(model.shape, model.max_scale, c.shell), ops, start_for(c, ops, start), body_events_for(c)));
   else
-    f(Assembly<RigidMixture, CellNeighbors>(model, CellNeighbors(model.interaction_range()), ops, start));
+    f(Assembly<RigidMixture, CellNeighbors>(model, CellNeighbors(model.interaction_range()), ops, start_for(c, ops, start), body_events_for(c)));
 }
 
 }  // namespace builder_detail
@@ -296,6 +345,9 @@ void assemble_rigid_mixture(const Config& c, F&& f) {
 // Calls f(assembly) with the typed Assembly of the config (see the header).
 template <class F>
 void assemble(const Config& c, F&& f) {
+  if (c.boundaries.walls.container())
+    throw ConfigError(fmt::format("{}: key 'walls.sphere': the spherical container is not available "
+                                  "yet in this version (planar walls are: walls.planes)", c.source));
   bool spheres = true;
   for (const Species& sp : c.species) spheres = spheres && std::holds_alternative<Sphere>(sp.shape);
   if (spheres) return builder_detail::assemble_spheres(c, f);

@@ -26,6 +26,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -148,6 +149,11 @@ struct GrowthOptions {
   // grown at rate 0.05 towards 0.75: the test fires at phi = 0.6928; a tenfold smaller threshold
   // reaches 0.6999 at 4x the cost).
   double jam_free_path = 1e-4;
+  // The box of the growth when it is not the cubic one the grow_* functions make from phi (an
+  // aspect ratio, walls): its sides define phi, and on its axes that are not periodic the bodies
+  // meet hard walls (locals/planar_walls.hpp, grazing step wall_eps) from the placement on.
+  std::optional<Box> box;
+  double wall_eps = 1e-5;
   // Called every 1024 events (not thread-safe; may be empty). Signals are polled at the same
   // points (core/interrupt.hpp): an interrupted growth throws hb::Interrupted.
   std::function<void(const GrowthStatus&)> report;
@@ -230,7 +236,8 @@ GrowthResult run_growth(Model model, State st, const Box& box, const GrowthOptio
     double v2 = 0.0;  // mean squared speed after the rescale (for the free path)
     for (const Vec3& v : st.v) v2 += v.squaredNorm();
     const double v_rms = std::sqrt(v2 / std::max(n, 1.0));
-    Sim sim(box, std::move(st), std::move(model), CellNeighbors(range), t);
+    Sim sim(box, std::move(st), std::move(model), CellNeighbors(range), t,
+            BodyEvents(PlanarWalls({!box.periodic[0], !box.periodic[1], !box.periodic[2]}, opt.wall_eps)));
     try {
     while (sim.step(t_next).type != EventType::None) {
       if ((++steps & 1023) != 0) continue;

@@ -37,6 +37,14 @@ double body_volume(const SpeciesTable& species, const State& s) {
   return v;
 }
 
+namespace {
+Box cubic_box(double volume) {
+  Box b;
+  b.L = Vec3::Constant(std::cbrt(volume));
+  return b;
+}
+}  // namespace
+
 std::vector<Vec3> random_sphere_placement(const std::vector<double>& radii, const Box& box,
                                           std::uint64_t seed) {
   pcg64 rng(seed, 0x706c6163656d656eull);  // stream "placemen"
@@ -60,7 +68,12 @@ std::vector<Vec3> random_sphere_placement(const std::vector<double>& radii, cons
   for (std::size_t i = 0; i < radii.size(); ++i) {
     bool placed = false;
     for (int attempt = 0; attempt < 10000 && !placed; ++attempt) {
-      const Vec3 r(u(rng) * box.L.x(), u(rng) * box.L.y(), u(rng) * box.L.z());
+      Vec3 r(u(rng) * box.L.x(), u(rng) * box.L.y(), u(rng) * box.L.z());
+      for (int k = 0; k < 3; ++k)  // clear of the walls of an axis that is not periodic
+        if (!box.periodic[k]) {
+          const double lo = radii[i] * 1.001 + 1e-5;
+          r[k] = lo + (r[k] / box.L[k]) * (box.L[k] - 2.0 * lo);
+        }
       const Eigen::Vector3i c = cell_of(r);
       bool free = true;
       for (int dx = -1; dx <= 1 && free; ++dx)
@@ -116,8 +129,7 @@ GrowthResult grow_sphere_mixture(const SpeciesTable& species, double phi, std::u
                                  const GrowthOptions& opt) {
   if (!(opt.phi0 > 0.0) || opt.phi0 > phi) throw std::invalid_argument("grow_sphere_mixture: need 0 < phi0 <= phi");
   State st = species_state(species, seed);
-  Box box;
-  box.L = Vec3::Constant(std::cbrt(body_volume(species, st) / phi));
+  const Box box = opt.box ? *opt.box : cubic_box(body_volume(species, st) / phi);
   const double s0 = std::cbrt(opt.phi0 / phi);
   HardSphereMixture model = HardSphereMixture::of(species, GrowthLaw{s0, opt.rate, 0.0, (1.0 - s0) / opt.rate});
   std::vector<double> radii(st.size()), masses(st.size());
@@ -178,8 +190,7 @@ GrowthResult grow_rigid_mixture(const SpeciesTable& species, double phi, std::ui
                                 const GrowthOptions& opt, double eps_d) {
   if (!(opt.phi0 > 0.0) || opt.phi0 > phi) throw std::invalid_argument("grow_rigid_mixture: need 0 < phi0 <= phi");
   State st = species_state(species, seed);
-  Box box;
-  box.L = Vec3::Constant(std::cbrt(body_volume(species, st) / phi));
+  const Box box = opt.box ? *opt.box : cubic_box(body_volume(species, st) / phi);
   double v_bounding = 0.0;  // bounding-sphere volume at scale 1
   for (std::size_t i = 0; i < st.size(); ++i)
     v_bounding += 4.18879020478639 * std::pow(bounding_radius(species[st.species[i]].shape) * st.scale[i], 3);

@@ -22,7 +22,9 @@
 
 #include "collision/sphere.hpp"
 #include "core/species.hpp"
+#include "collision/rigid.hpp"
 #include "motion/growth_law.hpp"
+#include "shapes/ellipsoid.hpp"
 #include "core/box.hpp"
 #include "core/state.hpp"
 
@@ -84,6 +86,16 @@ struct HardSphereMixture {
       }
       if (t <= window) out[k] = t;
     }
+  }
+
+  // Body i for the single-body event sources (walls): a smooth sphere of radius body_radius
+  // scaled by the growth law (its moment of inertia is never used).
+  static constexpr bool kBodyEvents = true;
+  template <class F>
+  void visit_body(const State& s, std::uint32_t i, double now, F&& f) const {
+    const double R = body_radius(s, i), m = body_mass(s, i);
+    f(Sphere{R}, MassProperties::spherical_top(m, 0.4 * m * R * R),
+      BodyGrowth{law.scale_at(now), law.rate_at(now)}, now < law.t_stop ? law.t_stop : kInf);
   }
 
   CollisionRecord collide(State& s, const Box& box, std::uint32_t i, std::uint32_t j, double now) const {

@@ -1,7 +1,10 @@
 // Pair model of identical smooth hard spheres (mass m, diameter sigma) for Simulation.
 #pragma once
+#include "collision/rigid.hpp"
 #include "collision/sphere.hpp"
 #include "contact/hard_sphere_time.hpp"
+#include "motion/growth_law.hpp"
+#include "shapes/ellipsoid.hpp"
 #include "core/box.hpp"
 #include "core/state.hpp"
 
@@ -52,6 +55,14 @@ struct HardSpheres {
       const double tc = c <= 0.0 ? 0.0 : t;
       out[k] = (b < 0.0 && disc >= 0.0 && j != i) ? tc : kInf;
     }
+  }
+
+  // Body i for the single-body event sources (walls): a smooth sphere (its moment of inertia is
+  // never used: no impulse on a smooth sphere has a torque).
+  static constexpr bool kBodyEvents = true;
+  template <class F>
+  void visit_body(const State&, std::uint32_t, double, F&& f) const {
+    f(Sphere{0.5 * sigma}, MassProperties::spherical_top(mass, 0.1 * mass * sigma * sigma), BodyGrowth{}, kInf);
   }
 
   CollisionRecord collide(State& s, const Box& box, std::uint32_t i, std::uint32_t j,

@@ -220,6 +220,13 @@ struct RigidBodies {
         });
   }
 
+  // Body i for the single-body event sources (walls): the shape at scale 1 with the growth.
+  static constexpr bool kBodyEvents = true;
+  template <class F>
+  void visit_body(const State&, std::uint32_t, double now, F&& f) const {
+    f(shape, mass, BodyGrowth{law.scale_at(now), law.rate_at(now)}, now < law.t_stop ? law.t_stop : kInf);
+  }
+
   CollisionRecord collide(State& s, const Box& box, std::uint32_t i, std::uint32_t j,
                           double now) const {
     BodyState a = s.body(i), b = s.body(j);  // both at `now`

@@ -113,6 +113,16 @@ struct RigidMixture {
         });
   }
 
+  // Body i for the single-body event sources (walls): its shape (scale_i) with the growth.
+  static constexpr bool kBodyEvents = true;
+  template <class F>
+  void visit_body(const State& s, std::uint32_t i, double now, F&& f) const {
+    const MassProperties m = body_mass(s, i);
+    const BodyGrowth g{law.scale_at(now), law.rate_at(now)};
+    const double law_end = now < law.t_stop ? law.t_stop : kInf;
+    std::visit([&](const auto& shape) { f(shape, m, g, law_end); }, body_shape(s, i));
+  }
+
   CollisionRecord collide(State& s, const Box& box, std::uint32_t i, std::uint32_t j,
                           double now) const {
     BodyState a = s.body(i), b = s.body(j);  // both at `now`

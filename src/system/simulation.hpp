@@ -16,11 +16,18 @@
 //       Non-windowed models get horizons = nullptr and predict without limit.
 //   CollisionRecord collide(State&, const Box&, i, j, double now)     // both bodies at `now`
 //   double interaction_range() const                                  // max centre distance at contact
+//   void visit_body(const State&, i, double now, F f)
+//       calls f(shape, MassProperties, BodyGrowth, law_end) with body i's shape (concrete type),
+//       mass, growth at `now` and the time its growth law changes: what the single-body event
+//       sources need (BodyEvents, only when they are active).
 // `Neighbors` (CellNeighbors, ShellNeighbors) supplies the candidates of a body and its own
 // event (cell crossing, list rebuild); see neighbors/.
+// `BodyEvents` (system/body_events.hpp) holds the event sources of single bodies: hard walls.
 //
-// Each body owns one slot of the calendar holding its earliest event; a collision event is
-// checked against the partner's counter when it comes up (lazy invalidation).
+// Each body owns one slot of the calendar holding its earliest event over all sources (pair
+// collision, single-body event, neighbour event); a collision event is checked against the
+// partner's counter when it comes up (lazy invalidation); a single-body event depends on its
+// owner alone, whose every change re-predicts it.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -30,6 +37,7 @@
 
 #include "collision/record.hpp"
 #include "events/event.hpp"
+#include "system/body_events.hpp"
 #include "events/queue.hpp"
 #include "core/box.hpp"
 #include "core/state.hpp"
@@ -45,6 +53,7 @@ struct LoopSnapshot {
   std::vector<Event> slot, best;
   std::array<std::uint64_t, kEventTypes> counts{};
   std::uint64_t stale = 0;
+  std::uint64_t rescheduled = 0;
 };
 
 struct StepInfo {
@@ -66,12 +75,15 @@ class Simulation {
   using neighbors_type = Neighbors;
   using model_type = Model;
 
-  Simulation(const Box& box, State state, Model model, Neighbors neighbors, double now = 0.0)
+  Simulation(const Box& box, State state, Model model, Neighbors neighbors, double now = 0.0,
+             BodyEvents events = {})
       : box_(box), state_(std::move(state)), model_(std::move(model)),
-        nb_(std::move(neighbors)), now_(now) {
+        nb_(std::move(neighbors)), events_(std::move(events)), now_(now) {
     prepare_state(model_, state_);
+    check_body_events();
     const std::size_t n = state_.size();
     if (n == 0) throw std::invalid_argument("no particles");
+    events_.prepare(n, now_);
     nb_.init(box_, state_, now_);
     queue_.reset(static_cast<std::uint32_t>(n));
     best_.assign(n, Event{});
@@ -80,10 +92,13 @@ class Simulation {
 
   // Continue from a snapshot (no re-prediction, no streaming: bit-for-bit continuation).
   // `neighbors` must have been restored to the same moment (see the neighbour classes).
-  Simulation(const Box& box, State state, Model model, Neighbors neighbors, const LoopSnapshot& snap)
+  Simulation(const Box& box, State state, Model model, Neighbors neighbors, const LoopSnapshot& snap,
+             BodyEvents events = {})
       : box_(box), state_(std::move(state)), model_(std::move(model)), nb_(std::move(neighbors)),
-        now_(snap.now), best_(snap.best), counts_(snap.counts), stale_(snap.stale) {
+        events_(std::move(events)), now_(snap.now), best_(snap.best), counts_(snap.counts),
+        stale_(snap.stale), rescheduled_(snap.rescheduled) {
     prepare_state(model_, state_);
+    check_body_events();
     const std::size_t n = state_.size();
     if (snap.slot.size() != n || snap.best.size() != n)
       throw std::invalid_argument("snapshot does not match the number of bodies");
@@ -98,6 +113,7 @@ class Simulation {
     s.best = best_;
     s.counts = counts_;
     s.stale = stale_;
+    s.rescheduled = rescheduled_;
     return s;
   }
 
@@ -107,8 +123,19 @@ class Simulation {
   const Model& model() const { return model_; }
   Model& model() { return model_; }
   const Neighbors& neighbors() const { return nb_; }
+  const BodyEvents& body_events() const { return events_; }
   const std::array<std::uint64_t, kEventTypes>& event_counts() const { return counts_; }
   std::uint64_t stale_events() const { return stale_; }
+  // Collisions whose re-prediction just before running them found the contact moved (later, or
+  // gone): they were rescheduled instead of run (set_recheck).
+  std::uint64_t rescheduled_events() const { return rescheduled_; }
+  // Re-check (on by default, as DynamO): before a collision runs, the pair's contact time is
+  // predicted again from the current state; a contact more than the model's recheck tolerance
+  // (Model::recheck_tolerance(), default 1e-9 time units) from now is rescheduled. It guards
+  // against predictions that come up early (a stale or faulty prediction); a healthy run's
+  // re-predictions are within the tolerance, so re-check changes no trajectory.
+  void set_recheck(bool on) { recheck_ = on; }
+  bool recheck() const { return recheck_; }
   std::uint64_t collisions() const { return counts_[static_cast<int>(EventType::Collision)]; }
   double next_event_time() const { return queue_.top().time; }
 
@@ -134,6 +161,16 @@ class Simulation {
       }
       state_.advance_to(i, now_);
       state_.advance_to(j, now_);
+      if (recheck_ && !contact_now(i, j)) {  // the contact moved: predict i again
+        info.stale = true;
+        ++rescheduled_;
+        if (++reschedule_streak_ > 1000)
+          throw std::runtime_error("re-check: more than 1000 collisions in a row moved when re-predicted "
+                                   "(bodies " + std::to_string(i) + ", " + std::to_string(j) + ")");
+        predict(i);
+        return info;
+      }
+      reschedule_streak_ = 0;
       info.record = model_.collide(state_, box_, i, j, now_);
       info.record.time = now_;
       // Guard against an endless sequence of collisions at one instant (a solver/impulse
@@ -154,16 +191,25 @@ class Simulation {
       predict(j);
       return info;
     }
+    if (ev.type == EventType::Wall || ev.type == EventType::Thermostat) {
+      state_.advance_to(i, now_);
+      if constexpr (with_bodies()) info.record = events_.run(model_, state_, box_, ev, now_);
+      ++state_.count[i];
+      ++counts_[static_cast<int>(ev.type)];
+      predict(i);
+      return info;
+    }
     if (ev.type != Neighbors::kEventType) throw std::logic_error("unexpected event type");
     ++counts_[static_cast<int>(ev.type)];
     state_.advance_to(i, now_);
     cand_.clear();
     shift_.clear();
     const bool partial = nb_.handle(i, ev, state_, box_, collect()) && !windowed();
-    // The trajectory is unchanged: if the remembered best collision is still valid, only the
-    // new candidates need predicting.
+    // The trajectory is unchanged: if the remembered best event is still valid (a collision
+    // whose partner has not changed, or a single-body event), only the new candidates need
+    // predicting.
     const Event& b = best_[i];
-    if (partial && (b.type == EventType::None || state_.count[b.partner] == b.partner_count)) {
+    if (partial && (b.type != EventType::Collision || state_.count[b.partner] == b.partner_count)) {
       Event best = b;
       consider(i, best);
       schedule(i, best);
@@ -173,12 +219,26 @@ class Simulation {
     return info;
   }
 
+  // Switch the thermostat on or off (an equilibration-only thermostat at the start of the
+  // measured stretch): every body is predicted again.
+  void set_thermostat(bool on) {
+    if (events_.thermostat().on() == on) return;
+    events_.thermostat().set_on(on);
+    for (std::uint32_t i = 0; i < state_.size(); ++i) predict(i);
+  }
+
   // Stream every body to the current time (for output; does not change any trajectory).
   void synchronize() {
     for (std::uint32_t i = 0; i < state_.size(); ++i) state_.advance_to(i, now_);
   }
 
  private:
+  // Models that describe single bodies (visit_body) can meet the single-body event sources.
+  static constexpr bool with_bodies() { return requires { Model::kBodyEvents; }; }
+  void check_body_events() const {
+    if (events_.active() && !with_bodies())
+      throw std::invalid_argument("this pair model cannot meet walls (no visit_body)");
+  }
   static constexpr bool windowed() {
     if constexpr (requires { Model::kWindowed; }) return Model::kWindowed;
     else return false;
@@ -188,6 +248,15 @@ class Simulation {
       cand_.push_back(j);
       shift_.push_back(shift);
     };
+  }
+  // Is the pair (i, j), both streamed to now, in contact now? Its contact time from the current
+  // state is within the tolerance.
+  bool contact_now(std::uint32_t i, std::uint32_t j) {
+    double dt = kInf;
+    model_.contact_times(state_, box_, i, &j, nullptr, 1, now_, nullptr, &dt);
+    double tol = 1e-9;
+    if constexpr (requires { model_.recheck_tolerance(); }) tol = model_.recheck_tolerance();
+    return dt <= tol;
   }
   // Predict body i against the candidates in cand_ and keep the earliest in `best`.
   void consider(std::uint32_t i, Event& best, double horizon = kInf) {
@@ -215,7 +284,9 @@ class Simulation {
       best.type = EventType::Collision;
     }
   }
-  // Full prediction for body i: all its candidates, and its next neighbour event.
+  // Full prediction for body i: all its candidates, its single-body events and its next
+  // neighbour event. Windowed models look only up to the neighbour event, where i is predicted
+  // in full again; the others keep the best event for partial re-predictions (see step()).
   void predict(std::uint32_t i) {
     state_.advance_to(i, now_);
     Event best;
@@ -224,7 +295,9 @@ class Simulation {
     shift_.clear();
     nb_.for_each_candidate(i, box_, collect());
     const Event ne = nb_.next_event(i, state_, now_);
-    consider(i, best, ne.time);
+    if constexpr (with_bodies())
+      if (events_.active()) best = events_.predict(model_, state_, box_, i, now_, windowed() ? ne.time : kInf);
+    consider(i, best, std::min(ne.time, best.time));  // nothing after i's own next event is needed
     best_[i] = best;
     queue_.set(ne.time < best.time ? ne : best);
   }
@@ -238,6 +311,7 @@ class Simulation {
   State state_;
   Model model_;
   Neighbors nb_;
+  BodyEvents events_;
   double now_ = 0.0;
   Queue queue_;
   std::vector<Event> best_;          // each body's best predicted collision
@@ -247,6 +321,8 @@ class Simulation {
   std::vector<double> limits_;       // their prediction horizons (windowed models)
   std::array<std::uint64_t, kEventTypes> counts_{};
   std::uint64_t stale_ = 0;
+  bool recheck_ = true;
+  std::uint64_t rescheduled_ = 0, reschedule_streak_ = 0;
   double last_collision_time_ = -kInf;
   std::uint64_t same_time_collisions_ = 0;
 };

@@ -33,7 +33,7 @@ TEST(HardSpherePhysics, HansenGoosFormulaMatchesReferenceTable) {
 // 10^6 collisions: energy and total momentum conserved to 1e-12, no overlaps.
 TEST(HardSpherePhysics, ConservesEnergyAndMomentumOverAMillionCollisions) {
   const auto s = run_config("conserve", sphere_config(4000, 0.45, 0.0, 1e6, 11, 1.0),
-                            {"run.max_collisions=1000000"});
+                            {"run.max_collisions=1000000", "output.trajectory=false"});
   EXPECT_EQ(s["collisions"].get<std::uint64_t>(), 1000000u);
   EXPECT_LE(std::abs(s["energy_drift"].get<double>()), 1e-12);
   EXPECT_LE(s["momentum_drift"].get<double>(), 1e-12);
