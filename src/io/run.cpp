@@ -256,7 +256,8 @@ class Driver {
         st_.next_gr = sim_.now();
         cpu_mark_ = cpu_seconds();
         wall_mark_ = progress_.wall_seconds();
-        if (cfg_.thermostat.during == ThermostatSpec::During::equilibration) sim_.set_thermostat(false);
+        if (cfg_.thermostat.active() && cfg_.thermostat.during == ThermostatSpec::During::equilibration)
+          sim_.set_thermostat(false);
       }
       // snapshots: a trajectory frame (if written), the independent checks and, with walls, the
       // profiles (sampled on the snapshot grid even without a trajectory)
