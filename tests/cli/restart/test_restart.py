@@ -152,13 +152,14 @@ checkpoint_interval = 0.2
 """
 
 
-@pytest.mark.parametrize("method", ["cells", "nnl"])
-def test_ellipsoid_resume_reproduces_uninterrupted_run(tmp_path, method):
-    cfg = tmp_path / "e.toml"
-    cfg.write_text(ELLIPSOIDS.format(method=method))
+def sigterm_resume(tmp_path, text, delay):
+    """The config run whole ("full") and stopped by SIGTERM after `delay` s then resumed ("part"):
+    asserts the final checkpoint states are equal; returns both summaries."""
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(text)
     full = run(["run", str(cfg), "--out", "full", "--quiet"], tmp_path)
     assert full.returncode == 0, full.stderr
-    code, err = interrupted_run(cfg, tmp_path / "part", tmp_path, signal.SIGTERM, 2.0)
+    code, err = interrupted_run(cfg, tmp_path / "part", tmp_path, signal.SIGTERM, delay)
     if code == 0:
         pytest.skip("the run finished before the signal")
     assert code == 128 + signal.SIGTERM, (code, err)
@@ -167,7 +168,52 @@ def test_ellipsoid_resume_reproduces_uninterrupted_run(tmp_path, method):
     a, b = final_state(tmp_path / "full"), final_state(tmp_path / "part")
     for k in a:
         assert np.array_equal(a[k], b[k]), k
-    sa = json.loads((tmp_path / "full" / "summary.json").read_text())
-    sb = json.loads((tmp_path / "part" / "summary.json").read_text())
+    return (json.loads((tmp_path / "full" / "summary.json").read_text()),
+            json.loads((tmp_path / "part" / "summary.json").read_text()))
+
+
+@pytest.mark.parametrize("method", ["cells", "nnl"])
+def test_ellipsoid_resume_reproduces_uninterrupted_run(tmp_path, method):
+    sa, sb = sigterm_resume(tmp_path, ELLIPSOIDS.format(method=method), 2.0)
     assert sa["collisions"] == sb["collisions"] and sa["Z"] == sb["Z"] and sa["overlaps"] == 0
     assert sa["neighbors"] == method
+
+
+WALLS = """
+[system]
+particles = 200
+packing_fraction = 0.3
+seed = 4
+[shape]
+type = "ellipsoid"
+semi_axes = [1.5, 0.5, 0.5]
+[box]
+aspect = [1.0, 1.0, 1.5]
+[walls]
+planes = ["z"]
+[thermostat]
+type = "andersen"
+rate = 0.2
+during = "always"
+[run]
+equilibrate_time = 5.0
+time = 30.0
+[neighbors]
+method = "nnl"
+[output]
+log_interval = 1.0
+snapshot_interval = 1.0
+checkpoint_interval = 0.2
+"""
+
+
+def test_walls_and_thermostat_resume_reproduces_uninterrupted_run(tmp_path):
+    """Walls (their pressure and profiles) and the Andersen thermostat (each body's next event
+    and event count) continue bit for bit after a SIGTERM."""
+    sa, sb = sigterm_resume(tmp_path, WALLS, 3.0)
+    for k in ["collisions", "Z", "wall_pressure", "wall_pressure_error", "events", "temperature"]:
+        assert sa[k] == sb[k], k
+    assert sa["events"]["thermostat"] > 0 and sa["events"]["wall"] > 0
+    assert sa["overlaps"] == 0 and sa["wall_penetrations"] == 0
+    for f in ["density_profile.tsv", "order_profile.tsv"]:
+        assert (tmp_path / "full" / f).read_text() == (tmp_path / "part" / f).read_text(), f
