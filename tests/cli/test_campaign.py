@@ -135,7 +135,10 @@ def test_killed_campaign_completes_with_identical_runs(reference, tmp_path):
     r = campaign([str(cfg)], tmp_path)
     assert r.returncode == 0, r.stderr
     logs = "".join(p.read_text() for p in (out / "logs").glob("*.log"))
-    assert logs.count("== exit 143") >= 3, logs  # runs were interrupted, and resumed
+    # runs were interrupted and resumed: how many of the kills land inside a run depends on the
+    # machine's speed (a clean-clone run on an idle machine saw 1 of 5 SIGTERMs stop a run, a
+    # loaded one 3 or more); the identity with the uninterrupted campaign below is the test
+    assert logs.count("== exit 143") >= 1, logs
     assert "--resume" in logs
     assert campaign_compare.compare(ref_out, out) == []
     rows = list(csv.DictReader(open(out / "results.csv")))
