@@ -580,8 +580,9 @@ class Driver {
       j["wall_pressure_error"] = wp.error;  // NaN -> null: fewer than 2 log blocks
       // the independent check of every snapshot and the final state: the support-function
       // distance of each body to each wall (> 0: through it)
-      worst_wall_penetration_ = std::max(worst_wall_penetration_, wall_penetration(st));
-      j["wall_penetrations"] = snapshot_wall_penetrations_ + (wall_penetration(st) > 0.0 ? 1 : 0);
+      const double final_pen = wall_penetration(st);
+      worst_wall_penetration_ = std::max(worst_wall_penetration_, final_pen);
+      j["wall_penetrations"] = snapshot_wall_penetrations_ + (final_pen > 0.0 ? 1 : 0);
       j["max_wall_penetration"] = worst_wall_penetration_;
       // hard spheres of one size: the contact value of the centre density (the contact theorem
       // says beta P_wall = rho(sigma / 2) at a planar wall)
