@@ -19,19 +19,10 @@
 // L the bounding radius (|R p| <= L). This is the paper's Eq. distplover, tightened by using
 // only the part of w normal to the face.
 //
-// Algorithm (conservative advancement, rigorous except for the grazing search of step 3):
-//  1. From t with distances d_f > 0 no face can be reached before t + d_f / K_f. Step
-//     dt = min_f max(d_f, eps) / K_f (at most eps / K_f per step near a face, so the number of
-//     steps is bounded by (t_max - t_start) max_f K_f / eps plus a logarithmic far part).
-//  2. A face with d_f < 0 at the end of a step brackets a root on that step.
-//  3. A face with d0 + d1 <= K_f dt (the only case in which the Lipschitz bound allows a hidden
-//     dip below zero; then both ends are within eps) whose rate goes from - to + inside the step
-//     is searched for its minimum by Brent's minimiser, stopping at the first negative value,
-//     which brackets the root on [t0, t_min]. The step is shorter than eps / K_f, so d_f is
-//     unimodal there in all but pathological cases.
-//  4. Every bracket of the step is shrunk on the sign of d_f (Illinois + bisection) to a width
-//     of a few ulps of t and its left end (d_f >= 0) is kept; the earliest face wins. The time
-//     returned is therefore never later than the first contact with the shrunken box.
+// Algorithm: the first root of the six d_f by conservative advancement (contact/first_root.hpp:
+// Lipschitz steps max(d_f, eps) / K_f, a grazing search where a hidden dip is possible, brackets
+// shrunk to a few ulps, the left end kept), so the time returned is never later than the first
+// contact with the shrunken box.
 // Growth: with scale s(t) = scale + scale_rate (t - t_state) the body is its shape scaled by s(t)
 // about its centre (Lubachevsky–Stillinger starts against walls, locals/planar_walls.hpp):
 // d_f(t) = c - margin - n.r(t) - s(t) h(R(t)^T n), d_f' gains -s' h and its rotational part the
@@ -47,8 +38,8 @@
 #include <array>
 #include <cmath>
 
+#include "contact/first_root.hpp"
 #include "geometry/obb.hpp"
-#include "math/brent.hpp"
 #include "math/types.hpp"
 #include "motion/free_flight.hpp"
 #include "motion/motion.hpp"
@@ -72,11 +63,7 @@ struct EscapeInput {
   double scale_rate = 0.0;
 };
 
-struct EscapeOptions {
-  long max_steps = 50'000'000;  // guard; exceeding it stops the search (status inside, time =
-                                // the last safe time, `truncated` set)
-  int brent_max_evals = 60;
-};
+using EscapeOptions = FirstRootOptions;  // max_steps exceeded: status inside, `truncated` set
 
 struct EscapeResult {
   EscapeStatus status = EscapeStatus::inside;
@@ -91,6 +78,7 @@ struct EscapeResult {
 // The six closed-form face distances of a body in free flight (shrunken box), and their rates.
 template <SupportShape S>
 struct BoxDistance {
+  static constexpr int kComponents = 6;  // the faces (contact/first_root.hpp)
   const S& shape;
   BodyState st;          // position relative to the box centre
   double t_state;
@@ -155,6 +143,7 @@ struct BoxDistance {
     return -u.dot(st.v) + scale_at(t) * (R * shape.support_point(nb)).dot(w.cross(u)) -
            sdot * shape.support(nb);
   }
+  double component_at(int f, double t) const { return face_at(f, t); }
   // |d_f'| <= K_f (a top that is not spherical: |w x u| <= max |w(t)|)
   double rate_bound(int f) const {
     const Vec3 u = axes.col(f >> 1);
@@ -165,88 +154,19 @@ struct BoxDistance {
 
 template <SupportShape S>
 EscapeResult escape_time(const EscapeInput<S>& in, const EscapeOptions& o = {}) {
-  EscapeResult out;
   const BoxDistance<S> D(in.shape, in.body, in.t_state, in.box, in.margin, in.scale,
                          in.scale_rate, in.t_max);
-  std::array<double, 6> K, d0, d1;
-  double kmax = 0.0;
-  for (int f = 0; f < 6; ++f) kmax = std::max(kmax, K[f] = D.rate_bound(f));
-  double t = in.t_start;
-  D.at(t, d0);
-  {
-    int fmin = 0;
-    for (int f = 1; f < 6; ++f)
-      if (d0[f] < d0[fmin]) fmin = f;
-    if (d0[fmin] < 0.0) {
-      out.status = EscapeStatus::outside;
-      out.time = t;
-      out.face = fmin;
-      out.distance = d0[fmin];
-      return out;
-    }
-  }
-  if (kmax == 0.0 || !(t < in.t_max)) return out;  // at rest (or empty window): never leaves
-  const double eps = std::max(in.eps, 1e-300);
-  auto ttol = [](double x) { return 8.0 * 2.220446049250313e-16 * std::max(1.0, std::abs(x)); };
-
-  while (t < in.t_max) {
-    if (++out.steps > o.max_steps) {
-      out.truncated = true;
-      out.time = t;
-      return out;
-    }
-    double dt = kInf;
-    for (int f = 0; f < 6; ++f)
-      if (K[f] > 0.0) dt = std::min(dt, std::max(d0[f], eps) / K[f]);
-    const double t1 = std::min(t + dt, in.t_max);
-    const double h = t1 - t;
-    D.at(t1, d1);
-    // brackets [t, hi_f] of this step, per face
-    double best_t = kInf;
-    int best_f = -1;
-    double best_d = 0.0;
-    std::array<double, 6> dd0{}, dd1{};
-    bool rates = false;
-    for (int f = 0; f < 6; ++f) {
-      double hi = kInf, dhi = 0.0;
-      if (d1[f] <= 0.0) {  // (a step of exactly d / K can land on the root: d1 = 0)
-        hi = t1, dhi = d1[f];
-      } else if (d0[f] + d1[f] <= K[f] * h) {  // a hidden dip is possible: grazing search
-        if (!rates) {
-          D.at(t, d0, &dd0);
-          D.at(t1, d1, &dd1);
-          rates = true;
-        }
-        if (dd0[f] < 0.0 && dd1[f] > 0.0) {
-          ++out.grazing_searches;
-          auto fn = [&](double x) { return D.face_at(f, x); };
-          const double x0 = t + h * d0[f] / (d0[f] + d1[f]);
-          const double xs = (x0 > t && x0 < t1) ? x0 : 0.5 * (t + t1);
-          const BrentMin m = brent_minimize(fn, t, t1, xs, ttol(t1), o.brent_max_evals,
-                                            [](double v) { return v < 0.0; });
-          if (m.fx < 0.0) hi = m.x, dhi = m.fx;
-        }
-      }
-      if (hi == kInf || !(t < best_t)) continue;
-      if (d0[f] == 0.0) {  // touching at the start of the step (only possible at t_start)
-        best_t = t, best_f = f, best_d = 0.0;
-        continue;
-      }
-      // shrink [t, hi] on the sign of d_f, keep the left end (d_f > 0)
-      const RootBracket br = bracket_root([&](double x) { return D.face_at(f, x); }, t, d0[f],
-                                          hi, dhi, ttol(hi), 200);
-      if (br.lo < best_t) best_t = br.lo, best_f = f, best_d = br.flo;
-    }
-    if (best_f >= 0) {
-      out.status = EscapeStatus::escapes;
-      out.time = best_t;
-      out.face = best_f;
-      out.distance = best_d;
-      return out;
-    }
-    t = t1;
-    d0 = d1;
-  }
+  const FirstRoot r = first_root(D, in.t_start, in.t_max, in.eps, o);
+  EscapeResult out;
+  out.status = r.status == RootStatus::found  ? EscapeStatus::escapes
+               : r.status == RootStatus::none ? EscapeStatus::inside
+                                              : EscapeStatus::outside;
+  out.time = r.time;
+  out.face = r.component;
+  out.distance = r.value;
+  out.steps = r.steps;
+  out.grazing_searches = r.grazing_searches;
+  out.truncated = r.truncated;
   return out;
 }
 

@@ -1,0 +1,149 @@
+// The first root of a set of overlap functions by conservative advancement: the one search behind
+// a body's escape from its neighbour-list box (contact/escape_time.hpp), its contact with a hard
+// planar wall (locals/planar_walls.hpp, through the escape time) and with a spherical container
+// (locals/spherical_container.hpp).
+//
+// Input: m component functions d_f(t) (a body's distances from the faces of a box, from a wall,
+// ...), each positive while nothing happens and Lipschitz on the window with a known bound,
+// |d_f'| <= K_f; the window [t_start, t_max] and the grazing step eps. The functions come as a
+// type F with
+//     static constexpr int kComponents;                               // m
+//     void at(double t, std::array<double, m>& d, std::array<double, m>* dd) const;
+//                                         // every d_f(t), and the rates d_f'(t) when dd != null
+//     double component_at(int f, double t) const;                     // d_f(t) alone
+//     double rate_bound(int f) const;                                 // K_f over the window
+// Output: the first time in the window at which some d_f reaches 0 (the left end of a bracket a
+// few ulps wide, so d_f >= 0 there), the component, and a status: found, none (no root in the
+// window) or negative (some d_f < 0 at t_start: time = t_start, the most negative component).
+//
+// Algorithm (rigorous except for the grazing search of step 3):
+//  1. From t with d_f > 0 no d_f can reach zero before t + d_f / K_f. Step
+//     dt = min_f max(d_f, eps) / K_f (at most eps / K_f per step near a root, so the number of
+//     steps is bounded by (t_max - t_start) max_f K_f / eps plus a logarithmic far part).
+//  2. A component with d_f <= 0 at the end of a step brackets a root on that step.
+//  3. A component with d0 + d1 <= K_f dt (the only case in which the Lipschitz bound allows a
+//     hidden dip below zero; both ends are then within eps) whose rate goes from - to + inside
+//     the step is searched for its minimum by Brent's minimiser, stopping at the first negative
+//     value, which brackets the root on [t0, t_min]. The step is shorter than eps / K_f, so d_f
+//     is unimodal there in all but pathological cases. A dip it misses is at most
+//     (d0 + d1 - K_f dt) / 2 >= -eps / 2 deep (Lipschitz): callers that must never pass a root
+//     search for d_f - eps / 2 (a margin; escape_time.hpp, the walls).
+//  4. Every bracket of the step is shrunk on the sign of d_f (Illinois + bisection) to a width
+//     of a few ulps of t and its left end (d_f >= 0) is kept; the earliest component wins. The
+//     time returned is therefore never later than the first root found.
+#pragma once
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "math/brent.hpp"
+#include "math/types.hpp"
+
+namespace hb {
+
+enum class RootStatus { found, none, negative };
+
+struct FirstRootOptions {
+  long max_steps = 50'000'000;  // guard; exceeding it stops the search (status none, time =
+                                // the last safe time, `truncated` set)
+  int brent_max_evals = 60;
+};
+
+struct FirstRoot {
+  RootStatus status = RootStatus::none;
+  double time = kInf;       // found/negative: the time; none: kInf (or last safe time if truncated)
+  int component = -1;
+  double value = kInf;      // d_f at `time` (>= 0 when found, < 0 when negative)
+  long steps = 0;
+  int grazing_searches = 0;
+  bool truncated = false;
+};
+
+template <class F>
+FirstRoot first_root(const F& fn, double t_start, double t_max, double eps_in,
+                     const FirstRootOptions& o = {}) {
+  constexpr int m = F::kComponents;
+  FirstRoot out;
+  std::array<double, m> K, d0, d1;
+  double kmax = 0.0;
+  for (int f = 0; f < m; ++f) kmax = std::max(kmax, K[f] = fn.rate_bound(f));
+  double t = t_start;
+  fn.at(t, d0, nullptr);
+  {
+    int fmin = 0;
+    for (int f = 1; f < m; ++f)
+      if (d0[f] < d0[fmin]) fmin = f;
+    if (d0[fmin] < 0.0) {
+      out.status = RootStatus::negative;
+      out.time = t;
+      out.component = fmin;
+      out.value = d0[fmin];
+      return out;
+    }
+  }
+  if (kmax == 0.0 || !(t < t_max)) return out;  // at rest (or empty window): no root
+  const double eps = std::max(eps_in, 1e-300);
+  auto ttol = [](double x) { return 8.0 * 2.220446049250313e-16 * std::max(1.0, std::abs(x)); };
+
+  while (t < t_max) {
+    if (++out.steps > o.max_steps) {
+      out.truncated = true;
+      out.time = t;
+      return out;
+    }
+    double dt = kInf;
+    for (int f = 0; f < m; ++f)
+      if (K[f] > 0.0) dt = std::min(dt, std::max(d0[f], eps) / K[f]);
+    const double t1 = std::min(t + dt, t_max);
+    const double h = t1 - t;
+    fn.at(t1, d1, nullptr);
+    // brackets [t, hi_f] of this step, per component
+    double best_t = kInf;
+    int best_f = -1;
+    double best_d = 0.0;
+    std::array<double, m> dd0{}, dd1{};
+    bool rates = false;
+    for (int f = 0; f < m; ++f) {
+      double hi = kInf, dhi = 0.0;
+      if (d1[f] <= 0.0) {  // (a step of exactly d / K can land on the root: d1 = 0)
+        hi = t1, dhi = d1[f];
+      } else if (d0[f] + d1[f] <= K[f] * h) {  // a hidden dip is possible: grazing search
+        if (!rates) {
+          fn.at(t, d0, &dd0);
+          fn.at(t1, d1, &dd1);
+          rates = true;
+        }
+        if (dd0[f] < 0.0 && dd1[f] > 0.0) {
+          ++out.grazing_searches;
+          auto g = [&](double x) { return fn.component_at(f, x); };
+          const double x0 = t + h * d0[f] / (d0[f] + d1[f]);
+          const double xs = (x0 > t && x0 < t1) ? x0 : 0.5 * (t + t1);
+          const BrentMin mn = brent_minimize(g, t, t1, xs, ttol(t1), o.brent_max_evals,
+                                             [](double v) { return v < 0.0; });
+          if (mn.fx < 0.0) hi = mn.x, dhi = mn.fx;
+        }
+      }
+      if (hi == kInf || !(t < best_t)) continue;
+      if (d0[f] == 0.0) {  // touching at the start of the step (only possible at t_start)
+        best_t = t, best_f = f, best_d = 0.0;
+        continue;
+      }
+      // shrink [t, hi] on the sign of d_f, keep the left end (d_f > 0)
+      const RootBracket br = bracket_root([&](double x) { return fn.component_at(f, x); }, t,
+                                          d0[f], hi, dhi, ttol(hi), 200);
+      if (br.lo < best_t) best_t = br.lo, best_f = f, best_d = br.flo;
+    }
+    if (best_f >= 0) {
+      out.status = RootStatus::found;
+      out.time = best_t;
+      out.component = best_f;
+      out.value = best_d;
+      return out;
+    }
+    t = t1;
+    d0 = d1;
+  }
+  return out;
+}
+
+}  // namespace hb
