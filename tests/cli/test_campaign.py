@@ -211,7 +211,7 @@ def test_plot_series_ignore_keys_zipped_with_x(tmp_path):
     import hardbody_campaign as hc
     c = hc.load(EXAMPLE / "eos-ellipsoids.toml")
     assert hc.plot_axes(c) == ("system.packing_fraction", [])
-    assert len(c.runs) == 30 and c.runs[0].name == "packing_fraction=0.05,time=500.0,seed=1"
+    assert len(c.runs) == 36 and c.runs[0].name == "packing_fraction=0.01,time=2000.0,seed=1"
     shutil.copy(EXAMPLE / "spheres-small-base.toml", tmp_path / "base.toml")
     (tmp_path / "g.toml").write_text('base = "base.toml"\n[grid]\n"neighbors.method" = ["cells", "nnl"]\n'
                                      '[zip]\n"system.packing_fraction" = [0.1, 0.2]\n"run.time" = [2.0, 1.0]\n'
