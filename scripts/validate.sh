@@ -17,6 +17,8 @@
 #   tops            10^6 collisions of N = 256 triaxial ellipsoids [1.5, 1, 0.6] (asymmetric tops,
 #                   uniform-density inertia) at phi = 0.40, NNL -> docs/validation/runs/tops.summary.json
 #                   (issue 11: per-axis rotational temperatures, energy drift)
+#   walls           the wall and container contact-time tests on 10,000 random bodies per shape
+#                   (HB_TEST_SCALE=10 of build/tests/locals/test_locals; make test runs 1000) (issue 12)
 #   tables          only rebuild the .md tables from the stored summaries
 #   slurm           campaigns on a one-node Slurm cluster (scripts/test-slurm-campaign.sh; issue 14)
 #   `scripts/validate.sh 1000000` (a number first) is the old form: the ellipsoids group.
@@ -194,8 +196,13 @@ TOML
     # munge, slurmctld, slurmd): scancel --signal=TERM and a time limit, requeued and resumed,
     # results identical to the local executor's (scripts/test-slurm-campaign.sh; ~5 minutes)
     HB="$HB" exec scripts/test-slurm-campaign.sh ;;
+  walls)
+    # issue 12: contact times against a slow conservative advancement, 10,000 bodies per shape
+    # (planar walls already run 10,000 in make test; the container's truth is slower: ~15 CPU min)
+    t=$(dirname "$HB")/../../tests/locals/test_locals
+    HB_TEST_SCALE=10 exec "$t" --gtest_filter='SphericalContainer.*ContactTime*' ;;
   tables) ;;
-  *) echo "unknown group '$group' (ellipsoids, ellipsoids-045, superquadrics, sq-taus, sq-vs-ellipsoid, tops, slurm, tables)" >&2
+  *) echo "unknown group '$group' (ellipsoids, ellipsoids-045, superquadrics, sq-taus, sq-vs-ellipsoid, tops, walls, slurm, tables)" >&2
      exit 2 ;;
 esac
 

@@ -533,7 +533,7 @@ class Driver {
 
     nlohmann::json j;
     j["particles"] = n;
-    j["packing_fraction"] = body_volume(cfg_.species, st) / sim_.box().volume();
+    j["packing_fraction"] = body_volume(cfg_.species, st) / phi_volume(cfg_, sim_.box());
     j["box"] = {sim_.box().L.x(), sim_.box().L.y(), sim_.box().L.z()};
     if (cfg_.species.size() == 1) {
       j["shape"] = shape_to_json(cfg_.one().shape);
@@ -585,13 +585,15 @@ class Driver {
       j["wall_penetrations"] = snapshot_wall_penetrations_ + (final_pen > 0.0 ? 1 : 0);
       j["max_wall_penetration"] = worst_wall_penetration_;
       // hard spheres of one size: the contact value of the centre density (the contact theorem
-      // says beta P_wall = rho(sigma / 2) at a planar wall)
+      // says beta P_wall = rho(sigma / 2) at a planar wall, rho(R - sigma / 2) (1 - sigma / 2R)^2
+      // in a spherical container of radius R)
       if (const Sphere* sph = std::get_if<Sphere>(&cfg_.one().shape);
-          sph && cfg_.species.size() == 1 && !cfg_.one().poly.active() && cfg_.boundaries.walls.any_plane() &&
+          sph && cfg_.species.size() == 1 && !cfg_.one().poly.active() && cfg_.boundaries.walls.any() &&
           profiles_->samples() > 0) {
         const int k = cfg_.boundaries.walls.planes[2] ? 2 : cfg_.boundaries.walls.planes[1] ? 1 : 0;
+        const bool radial = cfg_.boundaries.walls.container();
         try {
-          const ContactValue cv = contact_density(*profiles_, "xyz"[k], sph->radius);
+          const ContactValue cv = contact_density(*profiles_, radial ? 'r' : "xyz"[k], sph->radius);
           j["wall_contact_density"] = cv.density;
           j["wall_contact_density_error"] = cv.error;
         } catch (const std::invalid_argument&) {  // too few bins beyond contact: not reported
@@ -698,6 +700,7 @@ class Driver {
   std::optional<WallPressure> wall_pressure_;  // with walls
   std::optional<DensityProfiles> profiles_;    // with walls
   std::uint64_t snapshot_wall_penetrations_ = 0;
+  SphericalContainer container_{cfg_.boundaries.walls.sphere_radius, cfg_.eps_d};  // the check's
   double worst_wall_penetration_ = -kInf;
 
   // The deepest penetration of a body into a wall in a synchronised state (support-function
@@ -708,6 +711,10 @@ class Driver {
       const Box& box = sim_.box();
       for (std::uint32_t i = 0; i < s.size(); ++i)
         sim_.model().visit_body(s, i, sim_.now(), [&](const auto& shape, const MassProperties&, const BodyGrowth& g, double) {
+          if (container_.active()) {
+            worst = std::max(worst, -container_.distance(shape, s.body(i), g.s, box));
+            return;
+          }
           for (int f = 0; f < 6; ++f)
             if (!box.periodic[f >> 1])
               worst = std::max(worst, -PlanarWalls::distance(shape, s.body(i), g.s, box, f));
@@ -788,7 +795,7 @@ Start start_from_file(const Config& cfg) {
     if (count[a] != cfg.species[a].count)
       throw InputError(fmt::format("{} holds {} bodies of species {} ('{}'), the config {}", where, count[a], a,
                                    cfg.species[a].name, cfg.species[a].count));
-  const double phi = body_volume(cfg.species, s.state) / s.box.volume();
+  const double phi = body_volume(cfg.species, s.state) / phi_volume(cfg, s.box);
   if (!(std::abs(phi - cfg.packing_fraction) <= 1e-9 * cfg.packing_fraction))
     throw InputError(fmt::format("{}: its packing fraction is {:.17g}, system.packing_fraction is {}; set "
                                  "system.packing_fraction = {:.17g}", where, phi, cfg.packing_fraction, phi));

@@ -29,6 +29,10 @@ double container_radius_for(const Config& c, double phi) {
   return std::cbrt(total_body_volume(c) / phi / (4.0 / 3.0 * kPi));
 }
 
+double phi_volume(const Config& c, const Box& box) {
+  return c.boundaries.walls.container() ? container_volume(c.boundaries.walls.sphere_radius) : box.volume();
+}
+
 double packing_fraction(const Config& c) {
   const WallSpec& w = c.boundaries.walls;
   if (w.container()) return total_body_volume(c) / container_volume(w.sphere_radius);

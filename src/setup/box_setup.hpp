@@ -25,6 +25,8 @@ double container_volume(double radius);
 
 // The radius of the spherical container that holds the config's bodies at packing fraction phi.
 double container_radius_for(const Config& c, double phi);
+// The volume phi refers to: the spherical container's, or the box's.
+double phi_volume(const Config& c, const Box& box);
 
 // The run's packing fraction: with a spherical container (walls.sphere = R) the bodies' volume
 // over the container's, N v / (4 pi R^3 / 3); otherwise system.packing_fraction.

@@ -104,12 +104,13 @@ RigidSystemSpec plan_rigid(const Config& c);           // one species of non-sph
 RigidMixture plan_rigid_mixture(const Config& c);      // any other mixture or polydispersity
 
 // The single-body event sources of a config (system/body_events.hpp): hard planar walls on the
-// axes of walls.planes (grazing step solver.eps_d) and the Andersen thermostat of [thermostat]
-// (seeded by system.seed).
+// axes of walls.planes or the spherical container of walls.sphere (grazing step solver.eps_d) and
+// the Andersen thermostat of [thermostat] (seeded by system.seed).
 inline BodyEvents body_events_for(const Config& c) {
   AndersenThermostat th;
   if (c.thermostat.active()) th = AndersenThermostat(c.thermostat.rate, c.temperature, c.seed);
-  return BodyEvents(PlanarWalls(c.boundaries.walls.planes, c.eps_d), std::move(th));
+  return BodyEvents(PlanarWalls(c.boundaries.walls.planes, c.eps_d), std::move(th),
+                    SphericalContainer(c.boundaries.walls.sphere_radius, c.eps_d));
 }
 // A box that is not the default periodic cube: the starts grow the bodies in box_for(c).
 inline bool bounded(const Config& c) {
@@ -182,6 +183,7 @@ inline Start bounded_start(const Config& c, const OverlapCheck& check, const Sta
   g.kT = c.temperature;
   g.box = box_for(c);
   g.wall_eps = c.eps_d;
+  g.container = c.boundaries.walls.sphere_radius;
   g.report = opt.growth_report;
   bool spheres = true;
   for (const Species& sp : c.species) spheres = spheres && std::holds_alternative<Sphere>(sp.shape);
@@ -345,9 +347,6 @@ void assemble_rigid_mixture(const Config& c, F&& f) {
 // Calls f(assembly) with the typed Assembly of the config (see the header).
 template <class F>
 void assemble(const Config& c, F&& f) {
-  if (c.boundaries.walls.container())
-    throw ConfigError(fmt::format("{}: key 'walls.sphere': the spherical container is not available "
-                                  "yet in this version (planar walls are: walls.planes)", c.source));
   bool spheres = true;
   for (const Species& sp : c.species) spheres = spheres && std::holds_alternative<Sphere>(sp.shape);
   if (spheres) return builder_detail::assemble_spheres(c, f);

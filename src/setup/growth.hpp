@@ -154,6 +154,9 @@ struct GrowthOptions {
   // meet hard walls (locals/planar_walls.hpp, grazing step wall_eps) from the placement on.
   std::optional<Box> box;
   double wall_eps = 1e-5;
+  // > 0: a hard spherical container of this radius about the box centre instead of walls on the
+  // box faces (locals/spherical_container.hpp); its volume then defines phi.
+  double container = 0.0;
   // Called every 1024 events (not thread-safe; may be empty). Signals are polled at the same
   // points (core/interrupt.hpp): an interrupted growth throws hb::Interrupted.
   std::function<void(const GrowthStatus&)> report;
@@ -237,7 +240,9 @@ GrowthResult run_growth(Model model, State st, const Box& box, const GrowthOptio
     for (const Vec3& v : st.v) v2 += v.squaredNorm();
     const double v_rms = std::sqrt(v2 / std::max(n, 1.0));
     Sim sim(box, std::move(st), std::move(model), CellNeighbors(range), t,
-            BodyEvents(PlanarWalls({!box.periodic[0], !box.periodic[1], !box.periodic[2]}, opt.wall_eps)));
+            opt.container > 0.0
+                ? BodyEvents(PlanarWalls(), {}, SphericalContainer(opt.container, opt.wall_eps))
+                : BodyEvents(PlanarWalls({!box.periodic[0], !box.periodic[1], !box.periodic[2]}, opt.wall_eps)));
     try {
     while (sim.step(t_next).type != EventType::None) {
       if ((++steps & 1023) != 0) continue;

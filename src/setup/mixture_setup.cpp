@@ -46,7 +46,7 @@ Box cubic_box(double volume) {
 }  // namespace
 
 std::vector<Vec3> random_sphere_placement(const std::vector<double>& radii, const Box& box,
-                                          std::uint64_t seed) {
+                                          std::uint64_t seed, double container) {
   pcg64 rng(seed, 0x706c6163656d656eull);  // stream "placemen"
   std::uniform_real_distribution<double> u(0.0, 1.0);
   double rmax = 0.0;
@@ -69,11 +69,15 @@ std::vector<Vec3> random_sphere_placement(const std::vector<double>& radii, cons
     bool placed = false;
     for (int attempt = 0; attempt < 10000 && !placed; ++attempt) {
       Vec3 r(u(rng) * box.L.x(), u(rng) * box.L.y(), u(rng) * box.L.z());
-      for (int k = 0; k < 3; ++k)  // clear of the walls of an axis that is not periodic
-        if (!box.periodic[k]) {
-          const double lo = radii[i] * 1.001 + 1e-5;
-          r[k] = lo + (r[k] / box.L[k]) * (box.L[k] - 2.0 * lo);
-        }
+      if (container > 0.0) {  // inside the container (a candidate outside it is a failed attempt)
+        if ((r - box.centre()).norm() > container - radii[i] * 1.001 - 1e-5) continue;
+      } else {
+        for (int k = 0; k < 3; ++k)  // clear of the walls of an axis that is not periodic
+          if (!box.periodic[k]) {
+            const double lo = radii[i] * 1.001 + 1e-5;
+            r[k] = lo + (r[k] / box.L[k]) * (box.L[k] - 2.0 * lo);
+          }
+      }
       const Eigen::Vector3i c = cell_of(r);
       bool free = true;
       for (int dx = -1; dx <= 1 && free; ++dx)
@@ -125,6 +129,11 @@ void maxwell_boltzmann(State& s, double kT, const std::vector<double>& masses, s
   }
 }
 
+// The volume that defines phi in a growth: the container's, or the box's.
+static double growth_volume(const Box& box, const GrowthOptions& opt) {
+  return opt.container > 0.0 ? 4.0 / 3.0 * kPi * opt.container * opt.container * opt.container : box.volume();
+}
+
 GrowthResult grow_sphere_mixture(const SpeciesTable& species, double phi, std::uint64_t seed,
                                  const GrowthOptions& opt) {
   if (!(opt.phi0 > 0.0) || opt.phi0 > phi) throw std::invalid_argument("grow_sphere_mixture: need 0 < phi0 <= phi");
@@ -137,7 +146,7 @@ GrowthResult grow_sphere_mixture(const SpeciesTable& species, double phi, std::u
     radii[i] = model.body_radius(st, i) * s0;
     masses[i] = model.body_mass(st, i);
   }
-  st.r = random_sphere_placement(radii, box, seed);
+  st.r = random_sphere_placement(radii, box, seed, opt.container);
   maxwell_boltzmann(st, opt.kT, masses, seed);
   auto thermostat = [&](State& x) {
     const double k = model.kinetic_energy(x);
@@ -149,7 +158,7 @@ GrowthResult grow_sphere_mixture(const SpeciesTable& species, double phi, std::u
   o.phi_target = phi;
   GrowthResult res = s0 < 1.0 ? run_growth(model, std::move(st), box, o, thermostat) : GrowthResult{};
   if (s0 >= 1.0) res.state = std::move(st), res.box = box, res.s0 = 1.0;
-  res.phi = body_volume(species, res.state) / box.volume();
+  res.phi = body_volume(species, res.state) / growth_volume(box, opt);
   return res;
 }
 
@@ -194,7 +203,7 @@ GrowthResult grow_rigid_mixture(const SpeciesTable& species, double phi, std::ui
   double v_bounding = 0.0;  // bounding-sphere volume at scale 1
   for (std::size_t i = 0; i < st.size(); ++i)
     v_bounding += 4.18879020478639 * std::pow(bounding_radius(species[st.species[i]].shape) * st.scale[i], 3);
-  const double s0 = std::min(std::cbrt(opt.phi0 / phi), std::cbrt(0.25 * box.volume() / v_bounding));
+  const double s0 = std::min(std::cbrt(opt.phi0 / phi), std::cbrt(0.25 * growth_volume(box, opt) / v_bounding));
   const double t_stop = (1.0 - s0) / opt.rate;
   RigidMixture model = RigidMixture::of(species, eps_d, GrowthLaw{s0, opt.rate, 0.0, t_stop});
   std::vector<double> radii(st.size()), masses(st.size());
@@ -205,7 +214,7 @@ GrowthResult grow_rigid_mixture(const SpeciesTable& species, double phi, std::ui
     masses[i] = m.mass;
     inertia[i] = m.inertia_body.diagonal();
   }
-  st.r = random_sphere_placement(radii, box, seed);
+  st.r = random_sphere_placement(radii, box, seed, opt.container);
   random_orientations(st, seed);
   maxwell_boltzmann(st, opt.kT, masses, seed);
   maxwell_boltzmann_spin(st, opt.kT, inertia, seed);
@@ -219,7 +228,7 @@ GrowthResult grow_rigid_mixture(const SpeciesTable& species, double phi, std::ui
     res.state = std::move(st), res.box = box, res.s0 = 1.0;
   }
   res.s0 = s0;
-  res.phi = body_volume(species, res.state) / box.volume();
+  res.phi = body_volume(species, res.state) / growth_volume(box, opt);
   return res;
 }
 

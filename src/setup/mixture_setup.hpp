@@ -24,9 +24,10 @@ double body_volume(const SpeciesTable& species, const State& s);
 
 // Places spheres of the given radii uniformly at random in the box, none overlapping an earlier
 // one (random sequential addition, candidates from a cell grid); throws std::invalid_argument
-// when a body finds no place in 10^4 attempts.
+// when a body finds no place in 10^4 attempts. Clear of the walls of the box's axes that are not
+// periodic, or with container > 0 inside the sphere of that radius about the box centre.
 std::vector<Vec3> random_sphere_placement(const std::vector<double>& radii, const Box& box,
-                                          std::uint64_t seed);
+                                          std::uint64_t seed, double container = 0.0);
 
 // Gaussian velocities with per-body masses, zero total momentum, rescaled so that
 // 2 K / (3 N) = kT exactly (deterministic for the seed).

@@ -1,5 +1,5 @@
 // The event sources of single bodies, as the event loop sees them: a body against a fixed object
-// (locals/: hard planar walls) and system events that act on one body at a time (thermostat/: the
+// (locals/: hard planar walls, a hard spherical container) and system events that act on one body at a time (thermostat/: the
 // Andersen thermostat). Each
 // predicts the body's next event of its kind from the body's own trajectory only, so an event
 // stays valid until the body's own counter changes: the loop keeps it in the body's calendar slot
@@ -17,6 +17,7 @@
 #include "core/state.hpp"
 #include "events/event.hpp"
 #include "locals/planar_walls.hpp"
+#include "locals/spherical_container.hpp"
 #include "thermostat/andersen.hpp"
 
 namespace hb {
@@ -24,11 +25,13 @@ namespace hb {
 class BodyEvents {
  public:
   BodyEvents() = default;
-  explicit BodyEvents(PlanarWalls walls, AndersenThermostat thermostat = {})
-      : walls_(walls), thermostat_(std::move(thermostat)) {}
+  explicit BodyEvents(PlanarWalls walls, AndersenThermostat thermostat = {},
+                      SphericalContainer container = {})
+      : walls_(walls), container_(container), thermostat_(std::move(thermostat)) {}
 
-  bool active() const { return walls_.active() || thermostat_.active(); }
+  bool active() const { return walls_.active() || container_.active() || thermostat_.active(); }
   const PlanarWalls& walls() const { return walls_; }
+  const SphericalContainer& container() const { return container_; }
   const AndersenThermostat& thermostat() const { return thermostat_; }
   AndersenThermostat& thermostat() { return thermostat_; }
 
@@ -45,13 +48,15 @@ class BodyEvents {
                 double t_end) const {
     Event e;
     e.owner = i;
-    if (walls_.active()) {
+    if (walls_.active() || container_.active()) {
       m.visit_body(s, i, now, [&](const auto& shape, const MassProperties&, const BodyGrowth& g, double law_end) {
-        const WallContact c = walls_.contact(shape, s.body(i), g, box, now, std::min(t_end, law_end));
+        const WallContact c = walls_.active()
+                                  ? walls_.contact(shape, s.body(i), g, box, now, std::min(t_end, law_end))
+                                  : container_.contact(shape, s.body(i), g, box, now, std::min(t_end, law_end));
         if (c.time < e.time) {
           e.time = c.time;
           e.type = EventType::Wall;
-          e.partner = static_cast<std::uint32_t>(c.face);
+          e.partner = static_cast<std::uint32_t>(c.face);  // 0..5 box faces, 6 the container
         }
       });
     }
@@ -79,7 +84,8 @@ class BodyEvents {
     }
     m.visit_body(s, i, now, [&](const auto& shape, const MassProperties& mass, const BodyGrowth& g, double) {
       BodyState b = s.body(i);
-      rec = walls_.collide(shape, b, mass, g, static_cast<int>(e.partner));
+      rec = e.partner == SphericalContainer::kWall ? container_.collide(shape, b, mass, g, box)
+                                                   : walls_.collide(shape, b, mass, g, static_cast<int>(e.partner));
       s.v[i] = b.v;
       s.w[i] = b.w;
     });
@@ -89,7 +95,8 @@ class BodyEvents {
   }
 
  private:
-  PlanarWalls walls_;
+  PlanarWalls walls_;  // planar walls and the container exclude each other (the config's check)
+  SphericalContainer container_;
   AndersenThermostat thermostat_;
 };
 

@@ -1,6 +1,8 @@
 // Hard spheres between two hard walls (a slit 15 diameters wide, phi = 0.35): the contact theorem
 // (beta P_wall = density of centres at contact) and the wall pressure against the bulk equation
-// of state at the density of the middle of the slit.
+// of state at the density of the middle of the slit. Hard spheres in a spherical container: the
+// contact theorem at a curved wall. Superquadrics in a spherical container: no overlap, no body
+// through the wall, energy conserved.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -64,6 +66,61 @@ TEST(WallPhysics, HardSpheresInASlitObeyTheContactTheoremAndTheBulkEquationOfSta
   EXPECT_LT(std::abs(p - rc), 3.0 * std::hypot(pe, rce));
   // the bulk equation of state at the middle density: within 3 standard errors + 0.3 %
   EXPECT_LT(std::abs(p - p_hg), 3.0 * pe + 0.003 * p_hg);
+}
+
+// In a spherical container of radius R the centres touch the wall at R_c = R - sigma / 2 and the
+// total force on it is kT rho(R_c) 4 pi R_c^2 (observers/wall_observables.hpp): per unit wall area
+// beta P_wall (R / R_c)^2 = rho(R_c).
+TEST(WallPhysics, HardSpheresInASphericalContainerObeyTheContactTheorem) {
+  const std::string cfg =
+      "[system]\nparticles = 500\nseed = 5\n"
+      "[shape]\ntype = \"sphere\"\nradius = 0.5\n"
+      "[walls]\nsphere = 6.0\n"
+      "[run]\nequilibrate_time = 20.0\ntime = 600.0\n"
+      "[output]\nlog_interval = 10.0\nsnapshot_interval = 0.25\ntrajectory = false\n"
+      "[observables]\ninterval = 0.0\ngr_interval = 0.0\n";
+  const auto s = run_config("container-spheres", cfg);
+  const double p = s["wall_pressure"], pe = s["wall_pressure_error"];
+  const double rc = s["wall_contact_density"], rce = s["wall_contact_density_error"];
+  const double f = std::pow(6.0 / 5.5, 2);  // (R / R_c)^2
+  std::printf("  container: phi %.4f, beta P_wall = %.5f +- %.5f, x (R/R_c)^2 = %.5f; contact density "
+              "%.5f +- %.5f (%.2f sigma); %g collisions, %g wall bounces, drift %.2e\n",
+              s["packing_fraction"].get<double>(), p, pe, p * f, rc, rce,
+              (p * f - rc) / std::hypot(pe * f, rce), s["events"]["collision"].get<double>(),
+              s["events"]["wall"].get<double>(), s["energy_drift"].get<double>());
+  EXPECT_EQ(s["overlaps"].get<int>(), 0);
+  EXPECT_EQ(s["wall_penetrations"].get<int>(), 0);
+  EXPECT_LE(s["max_wall_penetration"].get<double>(), 0.0);
+  EXPECT_LE(std::abs(s["energy_drift"].get<double>()), 1e-11);
+  EXPECT_LT(pe, 0.01 * p) << "the wall pressure is not measured well enough to test";
+  EXPECT_LT(std::abs(p * f - rc), 3.0 * std::hypot(pe * f, rce));
+}
+
+// Superquadrics (semi-axes [1.2, 0.6, 0.6], exponents [2, 2, 8]) in a spherical container at
+// phi = 0.30, grown in it: every snapshot checked for overlaps (surface sampling) and for bodies
+// through the wall (the farthest point's distance from the centre), energy conserved
+// (examples/walls/superquadrics-container.toml runs the same for 10^6 events).
+TEST(WallPhysics, SuperquadricsInASphericalContainerStayInsideWithoutOverlap) {
+  const std::string cfg =
+      "[system]\nparticles = 128\nseed = 2\n"
+      "[shape]\ntype = \"superquadric\"\nsemi_axes = [1.2, 0.6, 0.6]\nexponents = [2.0, 2.0, 8.0]\n"
+      "[walls]\nsphere = 6.27\n"
+      "[init]\nmethod = \"grow\"\nphi0 = 0.05\ngrowth_rate = 0.05\n"
+      "[run]\nequilibrate_time = 2.0\ntime = 30.0\n[neighbors]\nmethod = \"nnl\"\n"
+      "[output]\nlog_interval = 1.0\nsnapshot_interval = 1.0\ntrajectory = false\n"
+      "[observables]\ninterval = 0.0\ngr_interval = 0.0\n";
+  const auto s = run_config("container-superquadrics", cfg);
+  std::printf("  superquadrics in a container: phi %.4f, %g collisions, %g wall bounces, %g rebuilds, "
+              "drift %.2e, deepest %.2e, beta P_wall %.4f\n",
+              s["packing_fraction"].get<double>(), s["events"]["collision"].get<double>(),
+              s["events"]["wall"].get<double>(), s["events"].value("nnl_rebuild", 0.0),
+              s["energy_drift"].get<double>(), s["max_wall_penetration"].get<double>(),
+              s["wall_pressure"].get<double>());
+  EXPECT_EQ(s["overlaps"].get<int>(), 0);
+  EXPECT_EQ(s["wall_penetrations"].get<int>(), 0);
+  EXPECT_LE(s["max_wall_penetration"].get<double>(), 0.0);
+  EXPECT_GT(s["events"]["wall"].get<double>(), 1000.0);
+  EXPECT_LE(std::abs(s["energy_drift"].get<double>()), 1e-12);
 }
 
 }  // namespace
