@@ -15,6 +15,9 @@ struct CollisionRecord {
   Vec3 n = Vec3::Zero();
   Vec3 r_AB = Vec3::Zero();
   double dE = 0.0;
+  // set by a model's collide(..., recheck) when the pair was found not in contact: nothing was
+  // changed and the event must be predicted again (system/simulation.hpp, re-check)
+  bool moved = false;
 };
 
 }  // namespace hb

@@ -178,9 +178,19 @@ inline CollisionRecord collide_separating(State& s, std::uint32_t i, std::uint32
   return rec;
 }
 
+// The re-check of a rigid pair at its collision (system/simulation.hpp): the pair is in contact
+// now when the gap d the collision's distance solve finds is within what the pair can close in the
+// re-check tolerance (seconds x its distance-rate bound), or within rounding of the solvers
+// (1e-9 of the pair's size; contacts are accepted at |d| <= 1e-10 L). A gap beyond both means the
+// contact is still ahead: the prediction came up early. recheck < 0: no check.
+inline bool recheck_moved(double gap, double recheck, double rate, double size) {
+  return recheck >= 0.0 && gap > std::max(recheck * rate, 1e-9 * size);
+}
+
 template <Shape S>
 struct RigidBodies {
   static constexpr bool kWindowed = true;  // predictions only up to the body's next neighbour event
+  static constexpr bool kRecheckInCollide = true;  // collide(..., recheck) (recheck_moved)
 
   S shape;  // at scale 1 (the target size when growing)
   MassProperties mass;
@@ -227,8 +237,10 @@ struct RigidBodies {
     f(shape, mass, BodyGrowth{law.scale_at(now), law.rate_at(now)}, now < law.t_stop ? law.t_stop : kInf);
   }
 
+  // recheck >= 0 (time units): the re-check of system/simulation.hpp, done on the distance this
+  // collision computes anyway; see recheck_moved.
   CollisionRecord collide(State& s, const Box& box, std::uint32_t i, std::uint32_t j,
-                          double now) const {
+                          double now, double recheck = -1.0) const {
     BodyState a = s.body(i), b = s.body(j);  // both at `now`
     const double sc = law.scale_at(now), sdot = law.rate_at(now);
     const auto [r_ab, d] = collision_contact(
@@ -245,6 +257,7 @@ struct RigidBodies {
     const double grow = growth_normal_speed(sc, sdot, d.normal, r_ab);
     const double L = shape.bounding_radius() * sc;
     const double rate = (b.v - a.v).norm() + (a.w.norm() + b.w.norm()) * L + 2.0 * sdot / sc * L;
+    if (recheck_moved(d.distance, recheck, rate, 2.0 * L)) return CollisionRecord{.moved = true};
     return collide_separating(s, i, j, a, b, mass, mass, d, r_ab, grow, rate, stats);
   }
 

@@ -39,6 +39,7 @@ namespace hb {
 
 struct RigidMixture {
   static constexpr bool kWindowed = true;  // predictions only up to the body's next neighbour event
+  static constexpr bool kRecheckInCollide = true;  // collide(..., recheck) (rigid_bodies.hpp recheck_moved)
 
   std::vector<AnyShape> shape;         // per species, at scale 1
   std::vector<double> mass;            // per species, at scale 1
@@ -123,8 +124,10 @@ struct RigidMixture {
     std::visit([&](const auto& shape) { f(shape, m, g, law_end); }, body_shape(s, i));
   }
 
+  // recheck >= 0 (time units): the re-check of system/simulation.hpp, done on the distance this
+  // collision computes anyway; see recheck_moved.
   CollisionRecord collide(State& s, const Box& box, std::uint32_t i, std::uint32_t j,
-                          double now) const {
+                          double now, double recheck = -1.0) const {
     BodyState a = s.body(i), b = s.body(j);  // both at `now`
     const double sc = law.scale_at(now), sdot = law.rate_at(now);
     const AnyShape sa = body_shape(s, i), sb = body_shape(s, j);
@@ -145,6 +148,7 @@ struct RigidMixture {
     const double La = bounding_radius(sa) * sc, Lb = bounding_radius(sb) * sc;
     const double rate = (b.v - a.v).norm() + a.w.norm() * La + b.w.norm() * Lb +
                         (sdot / sc) * (La + Lb);
+    if (recheck_moved(d.distance, recheck, rate, La + Lb)) return CollisionRecord{.moved = true};
     return collide_separating(s, i, j, a, b, body_mass(s, i), body_mass(s, j), d, r_ab, grow,
                               rate, stats);
   }
