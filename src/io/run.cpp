@@ -700,7 +700,6 @@ class Driver {
   std::optional<WallPressure> wall_pressure_;  // with walls
   std::optional<DensityProfiles> profiles_;    // with walls
   std::uint64_t snapshot_wall_penetrations_ = 0;
-  SphericalContainer container_{cfg_.boundaries.walls.sphere_radius, cfg_.eps_d};  // the check's
   double worst_wall_penetration_ = -kInf;
 
   // The deepest penetration of a body into a wall in a synchronised state (support-function
@@ -711,8 +710,8 @@ class Driver {
       const Box& box = sim_.box();
       for (std::uint32_t i = 0; i < s.size(); ++i)
         sim_.model().visit_body(s, i, sim_.now(), [&](const auto& shape, const MassProperties&, const BodyGrowth& g, double) {
-          if (container_.active()) {
-            worst = std::max(worst, -container_.distance(shape, s.body(i), g.s, box));
+          if (const SphericalContainer& c = sim_.body_events().container(); c.active()) {
+            worst = std::max(worst, -c.distance(shape, s.body(i), g.s, box));
             return;
           }
           for (int f = 0; f < 6; ++f)
