@@ -8,7 +8,7 @@
 // Algorithm.
 //  1. Bounding spheres (radii L_A, L_B, Eq. lalb) give the window in which a contact is
 //     possible: |r_AB(t)| <= L_A + L_B.  Empty window: `none`, without any distance solve.
-//  2. Stepping with the distance-rate bound (Eq. distOver)
+//  2. Stepping with the distance-rate bound (Eq. distOver; the rules of contact/first_root.hpp)
 //        |d'(t)| <= K = |v_B - v_A| + |w_A| L_A + |w_B| L_B :
 //     (for a top that is not spherical w changes along the flight: |w| is replaced by its
 //     maximum over the flight, Motion::max_angular_speed; motion/motion.hpp)
@@ -24,6 +24,12 @@
 //     minimum of d, stopping as soon as a negative value is seen; a negative minimum brackets a
 //     contact on [t0, t_min].  If d' has the same sign at both ends the minimum is at an end,
 //     where d > 0: no contact (d is smooth and the interval is shorter than eps_d / K).
+//  Steps 2 and 3 are the rules of contact/first_root.hpp (lipschitz_step, dip_possible,
+//  find_dip). The loop is not first_root itself: each sample is a warm-started distance solve
+//  that gives the rate with the value (first_root evaluates rates only for its dip test), it
+//  alternates with the axis leaps below, a bracket is refined by Newton on the contact system
+//  (step 4) rather than on the sign of d, and an initial overlap that separates is stepped
+//  through (first_root stops at a negative start).
 //  4. On a bracket [t_lo, t_hi] with d(t_lo) > 0 > d(t_hi): Newton-Raphson on the contact
 //     system (Eq. contime) in (x, alpha, t),
 //        F = ( grad f(x,t) + alpha^2 grad g(x,t),  f(x,t),  g(x,t) ) = 0,
@@ -44,7 +50,8 @@
 //  The gap g_n(t) along a fixed unit vector n (contact/axis_gap.hpp) is a lower bound of the
 //  distance that costs two support functions instead of a distance solve, with the rate bound
 //  |g_n'| <= K_n <= K and, for shapes with bounded curvature, |g_n''| <= M.  It is advanced by
-//  conservative steps, the larger of g / K_n and the positive root of g + g' dt - M dt^2 / 2:
+//  conservative steps, the larger of g / K_n and the positive root of g + g' dt - M dt^2 / 2
+//  (lipschitz_step and curvature_step of contact/first_root.hpp):
 //   a. before the first distance solve, along an axis found by a few gradient-ascent steps of
 //      the gap over directions (`separating_axis`), re-aimed where the gap runs low; a pair
 //      that cannot meet inside the window usually costs no distance solve at all, and the
@@ -83,6 +90,7 @@
 #include <cmath>
 
 #include "contact/axis_gap.hpp"
+#include "contact/first_root.hpp"
 #include "geometry/distance.hpp"
 #include "geometry/posed.hpp"
 #include "math/brent.hpp"
@@ -464,13 +472,8 @@ struct Solver {
         span = hi < kInf ? hi - t : 10.0 * std::max(g, in.eps_d) / G.Kn;
         G.bounds(std::max(G.scale_at(t), G.scale_at(t + span)));
       }
-      double dt = std::max(g, 0.0) / G.Kn;  // Kn = 0: the gap never changes, no contact
-      if (G.is_curved()) {
-        const double q = std::sqrt(std::max(slope * slope + 2.0 * G.M * g, 0.0));
-        const double dt2 =
-            slope <= 0.0 ? 2.0 * g / (q - slope) : (G.M > 0.0 ? (slope + q) / G.M : kInf);
-        dt = std::max(dt, dt2);
-      }
+      double dt = lipschitz_step(g, 0.0, G.Kn);  // Kn = 0: the gap never changes, no contact
+      if (G.is_curved()) dt = std::max(dt, curvature_step(g, slope, G.M));
       dt = std::min(dt, span);
       if (!(dt > 0.0)) break;
       const double t1 = t + dt;
@@ -623,12 +626,12 @@ struct Solver {
         return;
       }
       double Ks = K;
-      double dt = std::max(s.d, in.eps_d) / K;
+      double dt = lipschitz_step(s.d, in.eps_d, K);
       if (grow) {  // K over [s.t, s.t + dt0], then the (shorter) step that bound allows
         Ks = rate_bound(s.t, s.t);
-        dt = std::max(s.d, in.eps_d) / Ks;
+        dt = lipschitz_step(s.d, in.eps_d, Ks);
         Ks = rate_bound(s.t, s.t + dt);
-        dt = std::max(s.d, in.eps_d) / Ks;
+        dt = lipschitz_step(s.d, in.eps_d, Ks);
       }
       // d >= eps_d: the step is the rate bound itself, no contact before s.t + dt; if that
       // reaches the window's end there is nothing left to look at (saves the last solve).
@@ -649,7 +652,7 @@ struct Solver {
           report_hit(s.t, 0.5 * (s.res.point_a + s.res.point_b), s.res.normal);
           return;
         }
-      } else if (s.d + s1.d <= Ks * (t1 - s.t) && s.dd < 0.0 && s1.dd > 0.0 && s.d > 0.0) {
+      } else if (dip_possible(s.d, s1.d, Ks, t1 - s.t) && s.dd < 0.0 && s1.dd > 0.0 && s.d > 0.0) {
         // grazing: a minimum inside [s.t, t1] that may dip below zero
         ++out.grazing_searches;
         Sample neg;
@@ -658,7 +661,7 @@ struct Solver {
         // start from the minimum of the cubic Hermite model's quadratic part (secant of d')
         double x0 = s.t + width * (-s.dd) / (s1.dd - s.dd);
         x0 = std::clamp(x0, s.t + 0.05 * width, t1 - 0.05 * width);
-        brent_minimize(
+        find_dip(
             [&](double t) {
               const Sample q = eval(t);
               if (failed) return -1.0;
@@ -668,7 +671,7 @@ struct Solver {
               }
               return q.d;
             },
-            s.t, t1, x0, 1e-9 * width, o.brent_max_evals, [&](double v) { return v < 0.0; });
+            s.t, t1, x0, 1e-9 * width, o.brent_max_evals);
         if (failed) return;
         if (found) {
           solve_bracket(s, neg);

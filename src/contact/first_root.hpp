@@ -1,8 +1,27 @@
-// The first root of a set of overlap functions by conservative advancement: the one search behind
-// a body's escape from its neighbour-list box (contact/escape_time.hpp), its contact with a hard
-// planar wall (locals/planar_walls.hpp, through the escape time) and with a spherical container
-// (locals/spherical_container.hpp).
+// Conservative advancement: the rules of the engine's searches for the first time a moving body
+// touches something, and the search `first_root` built on them.
 //
+// The rules (one place for all searches; each is derived where it is defined below):
+//   lipschitz_step  from g >= 0 with |g'| <= K: no zero of g before t + max(g, eps) / K when
+//                   g >= eps (the floor eps keeps steps near a root at least eps / K long);
+//   curvature_step  from g >= 0 with rate g' and |g''| <= M: no zero before the positive root
+//                   of g + g' dt - M dt^2 / 2;
+//   dip_possible    a step [t0, t1] with g > 0 at both ends can hide a zero only if the
+//                   Lipschitz lower bound (g0 + g1 - K (t1 - t0)) / 2 is <= 0;
+//   find_dip        such a step with g turning inside it (g'(t0) < 0 < g'(t1)) is searched for
+//                   its minimum by Brent's minimiser, stopping at the first negative value.
+// Their clients:
+//   - first_root (below): a body's escape from its neighbour-list box (contact/escape_time.hpp),
+//     its contact with a hard planar wall (locals/planar_walls.hpp, through the escape time) and
+//     with a spherical container (locals/spherical_container.hpp);
+//   - the pair contact time (contact/contact_time.hpp), whose loop steps with lipschitz_step,
+//     dip_possible and find_dip but evaluates a warm-started distance solve (the rate comes
+//     with it), leaps along separating axes and refines brackets by Newton on the contact
+//     system;
+//   - the separating-axis advancement (contact/contact_time.hpp, contact/axis_gap.hpp), which
+//     steps with lipschitz_step and curvature_step along the gap of a fixed axis.
+//
+// first_root.
 // Input: m component functions d_f(t) (a body's distances from the faces of a box, from a wall,
 // ...), each positive while nothing happens and Lipschitz on the window with a known bound,
 // |d_f'| <= K_f; the window [t_start, t_max] and the grazing step eps. The functions come as a
@@ -18,7 +37,7 @@
 //
 // Algorithm (rigorous except for the grazing search of step 3):
 //  1. From t with d_f > 0 no d_f can reach zero before t + d_f / K_f. Step
-//     dt = min_f max(d_f, eps) / K_f (at most eps / K_f per step near a root, so the number of
+//     dt = min_f max(d_f, eps) / K_f (at least eps / K_f per step near a root, so the number of
 //     steps is bounded by (t_max - t_start) max_f K_f / eps plus a logarithmic far part).
 //  2. A component with d_f <= 0 at the end of a step brackets a root on that step.
 //  3. A component with d0 + d1 <= K_f dt (the only case in which the Lipschitz bound allows a
@@ -40,6 +59,34 @@
 #include "math/types.hpp"
 
 namespace hb {
+
+// From g with |g'| <= K: g(t + dt) >= g - K dt > 0 for dt < g / K. With the floor eps > 0 the
+// step is max(g, eps) / K: when g < eps it may overshoot a zero, which the step's end value or
+// the dip test below then catches. eps = 0: the rigorous step max(g, 0) / K.
+inline double lipschitz_step(double g, double eps, double K) { return std::max(g, eps) / K; }
+
+// From g >= 0 with rate g' = r and |g''| <= M (M >= 0): g(t + dt) >= g + r dt - M dt^2 / 2, whose
+// positive root is dt = (r + q) / M with q = sqrt(r^2 + 2 M g), written without cancellation:
+// 2 g / (q - r) when r <= 0 (equal, multiply by (q + r)), and (r + q) / M when r > 0 (M = 0 and
+// r > 0: the bound never reaches zero, kInf).
+inline double curvature_step(double g, double r, double M) {
+  const double q = std::sqrt(std::max(r * r + 2.0 * M * g, 0.0));
+  return r <= 0.0 ? 2.0 * g / (q - r) : (M > 0.0 ? (r + q) / M : kInf);
+}
+
+// A step of length h with values g0, g1 > 0 at its ends can hide a zero only if the Lipschitz
+// lower bound of g on it, (g0 + g1 - K h) / 2 (the two cones from the ends meet there), is <= 0.
+inline bool dip_possible(double g0, double g1, double K, double h) { return g0 + g1 <= K * h; }
+
+// The minimum of g on (t0, t1) from x0 by Brent's minimiser, stopping as soon as a value is
+// negative (then x brackets a zero with t0; `stopped` is set). The step is shorter than the
+// grazing step eps / K, so g is unimodal there in all but pathological cases; a dip missed
+// is at most (g0 + g1 - K h) / 2 >= -eps / 2 deep, which callers that must never pass a zero
+// cover with a margin of eps / 2.
+template <class G>
+BrentMin find_dip(G&& g, double t0, double t1, double x0, double xtol, int max_evals) {
+  return brent_minimize(g, t0, t1, x0, xtol, max_evals, [](double v) { return v < 0.0; });
+}
 
 enum class RootStatus { found, none, negative };
 
@@ -93,7 +140,7 @@ FirstRoot first_root(const F& fn, double t_start, double t_max, double eps_in,
     }
     double dt = kInf;
     for (int f = 0; f < m; ++f)
-      if (K[f] > 0.0) dt = std::min(dt, std::max(d0[f], eps) / K[f]);
+      if (K[f] > 0.0) dt = std::min(dt, lipschitz_step(d0[f], eps, K[f]));
     const double t1 = std::min(t + dt, t_max);
     const double h = t1 - t;
     fn.at(t1, d1, nullptr);
@@ -107,7 +154,7 @@ FirstRoot first_root(const F& fn, double t_start, double t_max, double eps_in,
       double hi = kInf, dhi = 0.0;
       if (d1[f] <= 0.0) {  // (a step of exactly d / K can land on the root: d1 = 0)
         hi = t1, dhi = d1[f];
-      } else if (d0[f] + d1[f] <= K[f] * h) {  // a hidden dip is possible: grazing search
+      } else if (dip_possible(d0[f], d1[f], K[f], h)) {  // grazing search
         if (!rates) {
           fn.at(t, d0, &dd0);
           fn.at(t1, d1, &dd1);
@@ -118,8 +165,7 @@ FirstRoot first_root(const F& fn, double t_start, double t_max, double eps_in,
           auto g = [&](double x) { return fn.component_at(f, x); };
           const double x0 = t + h * d0[f] / (d0[f] + d1[f]);
           const double xs = (x0 > t && x0 < t1) ? x0 : 0.5 * (t + t1);
-          const BrentMin mn = brent_minimize(g, t, t1, xs, ttol(t1), o.brent_max_evals,
-                                             [](double v) { return v < 0.0; });
+          const BrentMin mn = find_dip(g, t, t1, xs, ttol(t1), o.brent_max_evals);
           if (mn.fx < 0.0) hi = mn.x, dhi = mn.fx;
         }
       }
