@@ -106,16 +106,19 @@ struct FirstRoot {
   bool truncated = false;
 };
 
+// d_start: the values at t_start when the caller has them already (else they are evaluated).
 template <class F>
 FirstRoot first_root(const F& fn, double t_start, double t_max, double eps_in,
-                     const FirstRootOptions& o = {}) {
+                     const FirstRootOptions& o = {},
+                     const std::array<double, F::kComponents>* d_start = nullptr) {
   constexpr int m = F::kComponents;
   FirstRoot out;
   std::array<double, m> K, d0, d1;
   double kmax = 0.0;
   for (int f = 0; f < m; ++f) kmax = std::max(kmax, K[f] = fn.rate_bound(f));
   double t = t_start;
-  fn.at(t, d0, nullptr);
+  if (d_start) d0 = *d_start;
+  else fn.at(t, d0, nullptr);
   {
     int fmin = 0;
     for (int f = 1; f < m; ++f)

@@ -87,21 +87,24 @@ class PlanarWalls {
       // A body that has just bounced off a face sits on the shrunken face, to rounding on either
       // side; when it is not moving into it the search starts from the face as it is.
       const BoxDistance<S> D(shape, b, now, in.box, in.margin, g.s, g.rate, t_end);
-      std::array<double, 6> d, dd;
-      D.at(now, d, &dd);
+      std::array<double, 6> d;
+      D.at(now, d, nullptr);
       double worst = 0.0;
       for (int f = 0; f < 6; ++f) {
         if (!axes_[f >> 1] || !(d[f] < 0.0)) continue;
-        if (dd[f] < 0.0) return WallContact{now, f};  // into the wall: touching now
+        if (D.face_rate(f, now) < 0.0) return WallContact{now, f};  // into the wall: touching now
         worst = std::min(worst, d[f]);
       }
-      if (worst < 0.0) {
-        if (worst < -margin())
-          throw std::runtime_error("a body is through a wall (distance " + std::to_string(worst + margin()) + ")");
-        // shrink the box less, by twice the overshoot and some ulps of the coordinates (the
-        // face sits at L/2 - margin from the centre: a change below its rounding is lost)
-        in.margin = margin() + 2.0 * worst - 16.0 * 2.220446049250313e-16 * box.L.maxCoeff();
+      if (worst == 0.0) {  // the usual case: the search starts from the values just computed
+        const FirstRoot r = first_root(D, now, t_end, eps_, {}, &d);
+        if (r.status != RootStatus::none) out.time = r.time, out.face = r.component;
+        return out;
       }
+      if (worst < -margin())
+        throw std::runtime_error("a body is through a wall (distance " + std::to_string(worst + margin()) + ")");
+      // shrink the box less, by twice the overshoot and some ulps of the coordinates (the face
+      // sits at L/2 - margin from the centre: a change below its rounding is lost)
+      in.margin = margin() + 2.0 * worst - 16.0 * 2.220446049250313e-16 * box.L.maxCoeff();
       const EscapeResult r = escape_time(in);
       if (r.status != EscapeStatus::inside) out.time = r.time, out.face = r.face;
       return out;

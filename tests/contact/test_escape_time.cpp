@@ -263,7 +263,9 @@ TEST(EscapeTime, GrazingExitsAndNearMisses) {
     for (int g = 0; g < 3; ++g) c.box.half[g] += away;
     c.box.centre -= away * n;
     compare(c, 0.0, st);
-    if (delta > 0) EXPECT_EQ(run_ours(c, 0.0).status, EscapeStatus::inside) << "delta " << delta;
+    if (delta > 0) {
+      EXPECT_EQ(run_ours(c, 0.0).status, EscapeStatus::inside) << "delta " << delta;
+    }
   }
   report("grazing", st, 250);  // of ~650 grazes kept
 }
