@@ -834,6 +834,12 @@ Start make_start(const Config& cfg, const RunOptions& opt, const std::string& di
     return s;
   } catch (const GrowthJammed& e) {
     done();
+    if (cfg.boundaries.walls.container())  // the container's radius sets phi: name it
+      throw InputError(fmt::format("{}: key 'walls.sphere': a container of radius {} holds the {} bodies at "
+                                   "phi = {:.6g}, which cannot be reached: {}; ask for a larger container, or "
+                                   "grow more slowly (init.growth_rate)",
+                                   cfg.source, cfg.boundaries.walls.sphere_radius, cfg.particles,
+                                   cfg.packing_fraction, e.what()));
     throw InputError(fmt::format("{}: key 'system.packing_fraction': {} cannot be reached: {}; ask for a "
                                  "lower packing fraction, or grow more slowly (init.growth_rate)",
                                  cfg.source, cfg.packing_fraction, e.what()));

@@ -141,7 +141,8 @@ struct GrowthOptions {
   double rescale_interval = 0.5;   // simulated time between velocity rescalings
   double phi_target = 0.0;         // packing fraction at s = 1 (set by the grow_* functions)
   // Jam test: the growth stops (GrowthJammed) when the mean free path of the bodies, measured over
-  // windows of kJamWindow collisions per body, falls below jam_free_path x the interaction range
+  // windows of kJamWindow N pair collisions (a wall bounce counts as half of one: it ends one
+  // free flight), falls below jam_free_path x the interaction range
   // (the largest body diameter). For hard spheres beta P / rho ~ 0.3 sigma / (mean free path), so
   // the default 1e-4 is a reduced pressure ~ 3e3: far beyond any equilibrium state the growth
   // could be asked for (Z < 100 up to close packing of the crystal), and reached only when the
@@ -180,7 +181,7 @@ class GrowthFailed : public std::runtime_error {
   double time;
 };
 
-inline constexpr double kJamWindow = 25.0;  // collisions per body in a jam-test window
+inline constexpr double kJamWindow = 25.0;  // a jam-test window: kJamWindow N pair collisions
 
 struct GrowthResult {
   State state;  // synchronized; time stamps reset to 0 (the start of the continuing run)
@@ -228,9 +229,11 @@ GrowthResult run_growth(Model model, State st, const Box& box, const GrowthOptio
     g.fraction = t_stop > 0.0 ? t / t_stop : 1.0;
     return g;
   };
-  // jam test window: start time and collision count
+  // jam test window: start time, pair collisions and wall bounces at its start; `bounces` counts
+  // the wall bounces of the finished rescale intervals (a bounce ends one body's free flight, a
+  // pair collision two)
   double win_t = 0.0, free_path = 0.0;
-  std::uint64_t win_c = 0;
+  std::uint64_t win_c = 0, win_w = 0, bounces = 0;
   double t = 0.0;
   std::uint64_t steps = 0;  // events of the whole growth (signals and reports every 1024)
   while (t < t_stop) {
@@ -249,11 +252,13 @@ GrowthResult run_growth(Model model, State st, const Box& box, const GrowthOptio
       fault_point("growth");
       poll_interrupt("growth");
       const std::uint64_t c = res.collisions + sim.collisions();
-      if (double(c - win_c) >= kJamWindow * n) {
-        // mean free time: window time over collisions per body (2 bodies per collision)
-        const double tau = (sim.now() - win_t) * n / (2.0 * double(c - win_c));
+      const std::uint64_t w = bounces + sim.event_counts()[static_cast<int>(EventType::Wall)];
+      const double flights = 2.0 * double(c - win_c) + double(w - win_w);  // free flights ended
+      if (flights >= 2.0 * kJamWindow * n) {
+        // mean free time: window time over free flights ended per body
+        const double tau = (sim.now() - win_t) * n / flights;
         free_path = tau * v_rms;
-        win_t = sim.now(), win_c = c;
+        win_t = sim.now(), win_c = c, win_w = w;
         if (free_path < opt.jam_free_path * range) {
           const GrowthStatus g = status(sim.now(), c);
           throw GrowthJammed(fmt::format(
@@ -278,6 +283,7 @@ GrowthResult run_growth(Model model, State st, const Box& box, const GrowthOptio
     }
     sim.synchronize();
     res.collisions += sim.collisions();
+    bounces += sim.event_counts()[static_cast<int>(EventType::Wall)];
     st = sim.state();
     model = sim.model();
     t = t_next;

@@ -126,3 +126,28 @@ def test_a_run_can_start_from_a_gsd_frame(tmp_path):
              "--set", "system.particles=100"], tmp_path)
     assert r.returncode == 2 and "init.file" in r.stderr and "108 bodies" in r.stderr, r.stderr
     assert not (tmp_path / "c").exists()
+
+
+@pytest.mark.parametrize("walls", ["slit", "container"])
+def test_growth_against_walls_stops_when_jammed(tmp_path, walls):
+    """The jam test counts wall bounces as ended free flights (half a pair collision each): spheres
+    grown towards phi = 0.70 in a slit or in a spherical container stop at a packing that walls
+    loosen (random close packing ~0.64 in bulk, lower with walls), with exit 2 and nothing written.
+    In the container phi is set by walls.sphere, and the message names that key."""
+    cfg = tmp_path / "c.toml"
+    if walls == "slit":
+        bounds = '[system]\nparticles = 108\npacking_fraction = 0.70\nseed = 1\n[walls]\nplanes = ["z"]\n'
+        key = "system.packing_fraction"
+    else:
+        # R^3 = 3 N v / (4 pi phi) with v = pi / 6: phi = 0.70 for N = 108
+        radius = (108 / 8 / 0.70) ** (1 / 3)
+        bounds = f"[system]\nparticles = 108\nseed = 1\n[walls]\nsphere = {radius:.12f}\n"
+        key = "walls.sphere"
+    cfg.write_text(bounds + '[shape]\ntype = "sphere"\nradius = 0.5\n[init]\nmethod = "grow"\n[run]\ntime = 1.0\n')
+    r = run(["run", str(cfg), "--out", "o"], tmp_path)
+    assert r.returncode == 2, r.stderr
+    lines = [l for l in r.stderr.splitlines() if l.startswith("hardbody: error")]
+    assert len(lines) == 1 and f"key '{key}'" in lines[0] and "jammed" in lines[0], r.stderr
+    phi = float(lines[0].split("jammed at packing fraction ")[1].split()[0])
+    assert 0.45 < phi < 0.66, phi
+    assert not (tmp_path / "o").exists()
