@@ -55,7 +55,8 @@
 //   a. before the first distance solve, along an axis found by a few gradient-ascent steps of
 //      the gap over directions (`separating_axis`), re-aimed where the gap runs low; a pair
 //      that cannot meet inside the window usually costs no distance solve at all, and the
-//      first solve starts from the support points of the last axis (a warm start);
+//      first solve starts from the support points of the last axis (a guess, slid together
+//      by a short steepest descent before the NR: DistanceWarmStart::guess);
 //   b. after every distance sample with d >= eps_d, or with d' > 0 for curved shapes (a pair
 //      that just collided and separates), along its normal (there g_n = d, g_n' = d').
 //  Each step leaves g > 0, hence d > 0, behind it, so no contact is skipped; near contact
@@ -597,7 +598,8 @@ struct Solver {
       if (o.separating_axis && !warm.valid && axis_ma.squaredNorm() > 0.0) {
         const double sc = grow ? A.scale_at(lo) : 1.0;
         warm = DistanceWarmStart{sc * in.shape_a.support_point(axis_ma),
-                                 sc * in.shape_b.support_point(axis_mb), 1.0, 0.0, true};
+                                 sc * in.shape_b.support_point(axis_mb), 1.0, 0.0, true,
+                                 /*guess=*/true};
         warm_scale = sc;
       }
     }

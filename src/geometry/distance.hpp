@@ -78,7 +78,16 @@
 // or of the centre line scaled by the semi-axes (section 3.2, "A better guess"), refined by a few
 // steepest-descent steps on |x_A - x_B|^2 with the points held on the surfaces (section 2.3.2).
 // alpha = sqrt(|grad f| / |grad g|), beta = (x_B - x_A).grad f / |grad f|^2.  A warm start is
-// the previous solution of the same pair (its points in each body's own frame, alpha, beta).
+// the previous solution of the same pair (its points in each body's own frame, alpha, beta), or
+// a guess flagged as such (DistanceWarmStart::guess): the support points of A along a separating
+// axis n and of B along -n.  Their normals are antiparallel, but x_B - x_A need not be along n:
+// for long bodies side by side it has a component along their length, of the order of the
+// bodies' offset.  The 5-equation system puts x_B at x_A + beta grad f, off B's surface by that
+// component, and from there NR often ran to a spurious stationary point (beta < 0, rejected and
+// redone cold: 67,782 of 152,328 warm-started solves in 3000 collisions of ellipsoids X0 = 6 at
+// phi = 0.4, none at X0 <= 3; docs/benchmarks/README.md).  A guess
+// is therefore first slid together by the short steepest descent of the cold guesses (which
+// removes the component), then solved with options.warm_system.
 //
 // Systems: the 8-equation system is used from cold guesses (on the random test set it never
 // needed a fallback; the 5-equation one did in 7 of 10,000 pairs), the 5-equation system from
@@ -150,6 +159,10 @@ struct DistanceWarmStart {
   Vec3 xb_body = Vec3::Zero();
   double alpha = 1.0, beta = 0.0;
   bool valid = false;
+  // The points are a guess on the surfaces, not a solution of this pair: the support points
+  // of a separating axis (contact/contact_time.hpp).  They are refined by a short steepest
+  // descent before the NR (see the header, "Initial guess").
+  bool guess = false;
 };
 
 struct DistanceResult {
@@ -787,6 +800,8 @@ DistanceResult distance(const SA& a, const Pose& pa, const SB& b, const Pose& pb
     Point w;
     w.xa = warm->xa_body;
     w.xb = B.to_frame(warm->xb_body);
+    if (warm->guess)
+      res.sd_iterations += steepest_descent(A, B, w.xa, w.xb, o.sd_iter, o.sd_cos, o.sd_lambda);
     w = multipliers(A, B, w.xa, w.xb);
     run(1, w, o.warm_system);
   }
