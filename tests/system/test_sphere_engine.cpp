@@ -1,0 +1,121 @@
+// SphereEngine (the dedicated hard-sphere loop) against its slow twin, the generic
+// Simulation<HardSpheres, CellNeighbors>: from the same start both run the same collisions in
+// the same order at the same times; the cages leave no contact unseen (no overlaps after many
+// collisions, checked over all pairs); energy and momentum are conserved.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "setup/sphere_setup.hpp"
+#include "system/sphere_engine.hpp"
+
+using namespace hb;
+
+namespace {
+
+// Smallest pair distance over all pairs (brute force, minimum image), minus sigma.
+double worst_gap(const State& s, const Box& box, double sigma) {
+  double worst = kInf;
+  for (std::size_t i = 0; i < s.size(); ++i)
+    for (std::size_t j = i + 1; j < s.size(); ++j)
+      worst = std::min(worst, box.minimum_image(s.r[j] - s.r[i]).norm() - sigma);
+  return worst;
+}
+
+Vec3 momentum(const State& s) {
+  Vec3 p = Vec3::Zero();
+  for (const Vec3& v : s.v) p += v;
+  return p;
+}
+
+double energy(const State& s) {
+  double e = 0.0;
+  for (const Vec3& v : s.v) e += 0.5 * v.squaredNorm();
+  return e;
+}
+
+}  // namespace
+
+TEST(SphereEngine, SameCollisionsAsTheGenericLoop) {
+  for (const double phi : {0.3, 0.5}) {
+    for (const double shell : {0.05, 0.3}) {
+      SphereSystemSpec spec;
+      spec.n = 500;
+      spec.phi = phi;
+      spec.seed = 3;
+      Box box;
+      const State start = hard_sphere_start(spec, box);
+      auto sim = make_hard_sphere_cell_simulation(spec);
+      SphereEngine fast(box, start, spec.sigma, shell);
+      int compared = 0;
+      double worst_dt = 0.0;
+      while (compared < 2000) {
+        StepInfo a;
+        do a = sim.step(kInf);
+        while (a.type != EventType::Collision || a.stale);
+        SphereEngine::Step b;
+        do b = fast.step();
+        while (b.kind != SphereEngine::Kind::collision);
+        const auto lo = [](std::uint32_t x, std::uint32_t y) { return std::min(x, y); };
+        const auto hi = [](std::uint32_t x, std::uint32_t y) { return std::max(x, y); };
+        ASSERT_EQ(lo(a.record.a, a.record.b), lo(b.i, b.j)) << "collision " << compared;
+        ASSERT_EQ(hi(a.record.a, a.record.b), hi(b.i, b.j)) << "collision " << compared;
+        worst_dt = std::max(worst_dt, std::abs(a.record.time - b.time));
+        ASSERT_NEAR(a.record.time, b.time, 1e-9 * (1.0 + a.record.time)) << "collision " << compared;
+        ++compared;
+      }
+      std::printf("  phi %.2f shell %.2f: %d collisions equal, largest time difference %.2e, "
+                  "%llu cage exits\n",
+                  phi, shell, compared, worst_dt, (unsigned long long)fast.cage_exits());
+    }
+  }
+}
+
+TEST(SphereEngine, NoOverlapsAndConservation) {
+  SphereSystemSpec spec;
+  spec.n = 864;
+  spec.phi = 0.52;
+  spec.seed = 7;
+  Box box;
+  const State start = hard_sphere_start(spec, box);
+  SphereEngine fast(box, start, spec.sigma, 0.2);
+  const double e0 = energy(start);
+  const Vec3 p0 = momentum(start);
+  double worst = kInf;
+#ifdef NDEBUG
+  const std::uint64_t per_round = 20000;
+#else
+  const std::uint64_t per_round = 2000;  // Debug + sanitizers: ~50x slower
+#endif
+  for (int round = 0; round < 10; ++round) {
+    while (fast.collisions() < per_round * (round + 1)) fast.step();
+    const State s = fast.state();
+    worst = std::min(worst, worst_gap(s, box, spec.sigma));
+  }
+  const State s = fast.state();
+  const double drift = (energy(s) - e0) / e0;
+  std::printf("  %llu collisions, %llu cage exits, %llu stale: smallest gap %.3e, energy drift "
+              "%.2e, |dP| %.2e\n",
+              (unsigned long long)fast.collisions(), (unsigned long long)fast.cage_exits(),
+              (unsigned long long)fast.stale_events(), worst,
+              drift, (momentum(s) - p0).norm());
+  EXPECT_GT(fast.cage_exits(), per_round / 20);
+  EXPECT_GT(worst, -1e-10);
+  EXPECT_LT(std::abs(drift), 1e-12);
+  EXPECT_LT((momentum(s) - p0).norm(), 1e-10);
+}
+
+TEST(SphereEngine, RejectsBadInput) {
+  SphereSystemSpec spec;
+  spec.n = 32;
+  Box box;
+  const State start = hard_sphere_start(spec, box);
+  EXPECT_THROW(SphereEngine(box, start, 1.0, 0.2), std::invalid_argument);  // box < 3 cells
+  spec.n = 500;
+  const State s2 = hard_sphere_start(spec, box);
+  EXPECT_THROW(SphereEngine(box, s2, 1.0, 0.0), std::invalid_argument);
+  Box walled = box;
+  walled.periodic[2] = false;
+  EXPECT_THROW(SphereEngine(walled, s2, 1.0, 0.2), std::invalid_argument);
+}
