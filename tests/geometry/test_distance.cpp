@@ -381,7 +381,10 @@ TEST(Distance, SupportPointGuessOfStaggeredLongBodies) {
   std::printf("  %d pairs: first attempt failed %ld (plain warm start) vs %ld (guess), "
               "NR iterations per call %.2f vs %.2f\n",
               n, first_failed[0], first_failed[1], double(iters[0]) / n, double(iters[1]) / n);
-  EXPECT_LT(first_failed[1], first_failed[0]);
+  // (the plain start fails a few first attempts in the full sample, 5 of 3000; the reduced
+  // Debug sample may hold none of them, so only the guess's count is asserted exactly)
+  EXPECT_EQ(first_failed[1], 0);
+  EXPECT_LE(first_failed[1], first_failed[0]);
   EXPECT_LT(iters[1], iters[0]);
 }
 
