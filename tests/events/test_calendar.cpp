@@ -1,0 +1,161 @@
+// The bucketed calendar (events/calendar.hpp) against its obviously right twin, a linear scan for
+// the least (time, slot): the same slot on top after every operation, on event-driven sequences
+// (times at or after the current one), with ties, infinite times, times far beyond the lists
+// (the overflow), widths far too small or too large (the rebuilds) and idle stretches (the jump).
+#include <gtest/gtest.h>
+
+#include <pcg_random.hpp>
+#include <random>
+#include <vector>
+
+#include "events/calendar.hpp"
+
+using namespace hb;
+
+namespace {
+
+struct Brute {
+  std::vector<double> t;
+  std::uint32_t top() const {
+    std::uint32_t b = 0;
+    for (std::uint32_t i = 1; i < t.size(); ++i)
+      if (t[i] < t[b]) b = i;  // first of equal times: the lowest slot
+    return b;
+  }
+};
+
+// A discrete-event run: pop the top, give it a new time ahead, and move a few others; returns
+// the number of pops compared.
+struct Drive {
+  int compared = 0;
+  std::uint64_t rebuilds = 0, jumps = 0;
+};
+Drive drive(std::uint32_t n, double width, std::uint32_t lists, std::uint64_t seed, int pops,
+            double far_fraction, double inf_fraction, double mean_dt) {
+  Drive out;
+  Calendar q;
+  q.reset(n, width, lists, 0.0);
+  Brute b;
+  b.t.assign(n, Calendar::kInf);
+  pcg32 rng(seed);
+  std::uniform_int_distribution<std::uint32_t> pick(0, n - 1);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::exponential_distribution<double> ex(1.0 / mean_dt);
+  std::uniform_int_distribution<int> coarse(0, 5);
+  double now = 0.0;
+  auto draw = [&]() {
+    const double r = u(rng);
+    if (r < inf_fraction) return Calendar::kInf;
+    if (r < inf_fraction + far_fraction) return now + 1e3 * mean_dt * (1.0 + u(rng));
+    if (r < inf_fraction + far_fraction + 0.2) return now + coarse(rng) * mean_dt;  // ties
+    return now + ex(rng);
+  };
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const double t = draw();
+    q.set(i, t);
+    b.t[i] = t;
+  }
+  int& compared = out.compared;
+  for (int k = 0; k < pops; ++k) {
+    const std::uint32_t top = q.top();
+    if (top != b.top()) {
+      ADD_FAILURE() << "pop " << k << ": calendar top " << top << " at " << q.time_of(top)
+                    << ", brute top " << b.top() << " at " << b.t[b.top()];
+      return out;
+    }
+    ++compared;
+    if (b.t[top] == Calendar::kInf) {  // nothing finite ahead: revive a few
+      for (int m = 0; m < 3; ++m) {
+        const std::uint32_t i = pick(rng);
+        const double t = now + ex(rng);
+        q.set(i, t);
+        b.t[i] = t;
+      }
+      continue;
+    }
+    now = b.t[top];
+    double t = draw();
+    q.set(top, t);
+    b.t[top] = t;
+    const int others = static_cast<int>(u(rng) * 3);
+    for (int m = 0; m < others; ++m) {  // partners re-predicted (earlier or later)
+      const std::uint32_t i = pick(rng);
+      t = u(rng) < 0.1 ? now : draw();
+      q.set(i, t);
+      b.t[i] = t;
+    }
+  }
+  out.rebuilds = q.rebuilds();
+  out.jumps = q.jumps();
+  return out;
+}
+
+}  // namespace
+
+TEST(Calendar, PopsLikeALinearScan) {
+  // width about right, too small and too large; few and many lists
+  EXPECT_EQ(drive(500, 0.02, 125, 1, 20000, 0.01, 0.01, 1.0).compared, 20000);
+  const Drive small = drive(500, 1e-6, 125, 2, 20000, 0.01, 0.01, 1.0);
+  EXPECT_EQ(small.compared, 20000);
+  EXPECT_GT(small.rebuilds, 0u);  // the width was re-tuned
+  const Drive large = drive(500, 1e3, 125, 3, 20000, 0.01, 0.01, 1.0);
+  EXPECT_EQ(large.compared, 20000);
+  EXPECT_GT(large.rebuilds, 0u);
+  EXPECT_EQ(drive(64, 0.05, 1, 4, 20000, 0.05, 0.0, 1.0).compared, 20000);
+  EXPECT_EQ(drive(3000, 0.005, 750, 5, 30000, 0.0, 0.0, 1.0).compared, 30000);
+}
+
+TEST(Calendar, OverflowInfinitiesAndIdleStretches) {
+  // half the times far beyond the lists; most infinite (the top is then often infinite); a
+  // single slot (idle turns, then jumps to it)
+  EXPECT_EQ(drive(200, 0.01, 50, 6, 20000, 0.5, 0.0, 1.0).compared, 20000);
+  EXPECT_EQ(drive(200, 0.01, 50, 7, 20000, 0.0, 0.9, 1.0).compared, 20000);
+  std::uint64_t jumps = 0;
+  for (std::uint64_t seed = 8; seed < 16; ++seed) {
+    const Drive one = drive(1, 0.01, 4, seed, 2000, 0.3, 0.3, 1.0);
+    EXPECT_EQ(one.compared, 2000);
+    jumps += one.jumps;
+  }
+  EXPECT_GT(jumps, 0u);  // the jump over idle turns was taken
+}
+
+TEST(Calendar, NegativeTimes) {
+  // a run that starts before time 0 (buckets of negative index, lists taken modulo nb)
+  Calendar q;
+  q.reset(40, 0.1, 7, -5.0);
+  Brute b;
+  b.t.assign(40, Calendar::kInf);
+  pcg32 rng(21);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  double now = -5.0;
+  for (std::uint32_t i = 0; i < 40; ++i) q.set(i, b.t[i] = now + 3.0 * u(rng));
+  for (int k = 0; k < 2000; ++k) {
+    const std::uint32_t top = q.top();
+    ASSERT_EQ(top, b.top()) << "pop " << k;
+    now = b.t[top];
+    q.set(top, b.t[top] = now + 3.0 * u(rng));
+  }
+  EXPECT_GT(now, 0.0);  // the run crossed time 0
+}
+
+TEST(Calendar, AllInfiniteGivesTheLowestSlot) {
+  Calendar q;
+  q.reset(10, 0.1, 4, 0.0);
+  EXPECT_EQ(q.top(), 0u);
+  q.set(7, 3.5);
+  EXPECT_EQ(q.top(), 7u);
+  q.set(7, Calendar::kInf);
+  q.set(3, Calendar::kInf);
+  EXPECT_EQ(q.top(), 0u);
+  EXPECT_EQ(q.time_of(0), Calendar::kInf);
+}
+
+TEST(Calendar, EqualTimesPopInSlotOrder) {
+  Calendar q;
+  q.reset(6, 0.5, 4, 0.0);
+  for (std::uint32_t i : {5u, 2u, 4u, 0u, 3u, 1u}) q.set(i, 2.25);
+  for (std::uint32_t want = 0; want < 6; ++want) {
+    EXPECT_EQ(q.top(), want);
+    q.set(want, Calendar::kInf);
+  }
+}
