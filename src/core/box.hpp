@@ -9,6 +9,20 @@
 
 namespace hb {
 
+// One periodic axis of length L (half = L / 2), for loops over raw coordinates: the minimum
+// image of a separation known to lie within (-1.5 L, 1.5 L), and a coordinate known to lie within
+// [-L, 2 L) wrapped into [0, L).  One compare each way, no division.
+inline double image_once(double d, double L, double half) {
+  if (d > half) return d - L;
+  if (d < -half) return d + L;
+  return d;
+}
+inline double wrap_once(double x, double L) {
+  if (x >= L) return x - L;
+  if (x < 0.0) return x + L;
+  return x;
+}
+
 struct Box {
   Vec3 L = Vec3::Ones();
   std::array<bool, 3> periodic{true, true, true};

@@ -5,8 +5,12 @@
 //
 // What it does differently from the generic loop (the ideas of the fastest public hard-sphere
 // codes; the code is our own):
-//  * One compact 64-byte record per sphere (position, own clock, velocity, event counter): the
-//    loads of a prediction touch one cache line per candidate.
+//  * One compact 64-byte record per sphere (position, own clock, velocity, event counter, input
+//    number): the loads of a prediction touch one cache line per candidate.
+//  * The records are kept in the order of a space-filling curve (Morton order of the cage
+//    centres' cells), re-sorted every few N events: neighbours sit close in memory, so a
+//    prediction's loads mostly hit the cache at large N.  Steps and states speak of the spheres'
+//    input numbers.
 //  * Cages instead of cell crossings.  Each sphere i owns a cage, the ball of radius s/2 about
 //    its cage centre c_i (its position when the cage was made), and a neighbour list holding
 //    every j with |c_i - c_j| < sigma + s (minimum image), kept symmetric.  While both spheres
@@ -20,8 +24,10 @@
 //    contact (c = r^2 - sigma^2 >= 0) the first root t = c / (sqrt(b^2 - a c) - b) satisfies
 //    t >= c / (-2 b) (sqrt(b^2 - a c) <= -b), so a pair with c >= -2 b t_best cannot beat the
 //    best time found so far and is dropped without the square root.
-//  * One event per sphere (its earliest collision or its cage exit) in a binary heap whose nodes
-//    hold the event time inline (a sift reads contiguous memory, not the event records).
+//  * One event per sphere (its earliest collision or its cage exit) in a bucketed calendar
+//    (events/calendar.hpp): only the events of the current bucket are sorted, in a small heap;
+//    later ones are inserted and removed in O(1).  Its width starts at 6 mean event times / N
+//    and adapts.
 //  A collision event carries the partner's event counter at prediction; if the partner has
 //  changed velocity since, the event is stale and the owner is predicted again (as in the
 //  generic loop).
@@ -29,8 +35,7 @@
 // Cage exit: with p = x_i - c_i (minimum image), |p + v tau| = s / 2 first at
 //     tau = (-b + sqrt(b^2 - a c)) / a,   a = v.v, b = p.v, c = p.p - s^2 / 4 <= 0,
 // written as tau = -c / (b + sqrt(b^2 - a c)) when b > 0 (no cancellation).
-// Collision (equal masses): with the unit normal n from i to j and dv = v_j - v_i,
-//     v_i += (dv.n) n,  v_j -= (dv.n) n.
+// Collision: collide_spheres (collision/sphere.hpp) with equal masses.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -39,15 +44,17 @@
 #include <string>
 #include <vector>
 
+#include "collision/sphere.hpp"
 #include "core/box.hpp"
 #include "core/state.hpp"
+#include "events/calendar.hpp"
 #include "math/types.hpp"
 
 namespace hb {
 
 class SphereEngine {
  public:
-  static constexpr int kMaxNeighbours = 20;  // per sphere (memory: 4 bytes each)
+  static constexpr int kMaxNeighbours = 24;  // per sphere (memory: 4 bytes each)
   static constexpr std::uint32_t kCage = 0xffffffffu;  // partner of a cage-exit event
 
   enum class Kind { collision, cage, stale };
@@ -64,6 +71,7 @@ class SphereEngine {
     if (!box.fully_periodic()) throw std::invalid_argument("SphereEngine: the box must be periodic");
     if (!(shell > 0.0)) throw std::invalid_argument("SphereEngine: the shell must be positive");
     const std::size_t n = s.size();
+    if (n == 0) throw std::invalid_argument("SphereEngine: no spheres");
     p_.resize(n);
     cage_.resize(n);
     nb_.assign(n * kMaxNeighbours, 0);
@@ -73,6 +81,7 @@ class SphereEngine {
       q.x = wrap(r.x(), 0), q.y = wrap(r.y(), 1), q.z = wrap(r.z(), 2);
       q.t = now;
       q.vx = s.v[i].x(), q.vy = s.v[i].y(), q.vz = s.v[i].z();
+      q.id = static_cast<std::uint32_t>(i);
       q.count = 0;
       q.nn = 0;
     }
@@ -92,13 +101,24 @@ class SphereEngine {
     }
     for (std::uint32_t i = 0; i < n; ++i) fill_list(i, /*only_higher=*/true);
     ev_.resize(n);
-    heap_.resize(n);
-    pos_.resize(n);
-    for (std::uint32_t i = 0; i < n; ++i) {
-      heap_[i] = Node{kInf, i};
-      pos_[i] = i;
-    }
+    const std::uint32_t lists = std::max<std::uint32_t>(16, std::uint32_t(n / 4));  // 2 B/sphere
+    q_.reset(static_cast<std::uint32_t>(n), 1.0, lists, now);
     for (std::uint32_t i = 0; i < n; ++i) predict(i);
+    // Buckets of about Calendar::kPerBucket events: a sphere's next event is some mean time tau
+    // ahead, so N / tau events happen per unit time.
+    double sum = 0.0;
+    std::size_t finite = 0;
+    for (std::uint32_t i = 0; i < n; ++i)
+      if (q_.time_of(i) < kInf) sum += q_.time_of(i) - now, ++finite;
+    if (finite > 0 && sum > 0.0) q_.set_width(Calendar::kPerBucket * (sum / finite) / n);
+    reorder_every_ = 16 * std::uint64_t(n);
+    reorder();
+  }
+
+  // Re-sort the records along the curve every `events` events (0: never; default 16 N).
+  void set_reorder_interval(std::uint64_t events) {
+    reorder_every_ = events;
+    next_reorder_ = events == 0 ? ~std::uint64_t(0) : events_ + events;
   }
 
   double now() const { return now_; }
@@ -109,12 +129,15 @@ class SphereEngine {
 
   // Process the next event.
   Step step() {
-    const Node top = heap_[0];
-    const std::uint32_t i = top.id;
+    if (events_ >= next_reorder_) reorder();
+    ++events_;
+    const std::uint32_t i = q_.top();
     const Ev e = ev_[i];
-    now_ = top.time;
+    if (!(q_.time_of(i) < kInf))
+      throw std::runtime_error("SphereEngine: no event ahead (every sphere is at rest)");
+    now_ = q_.time_of(i);
     Step out;
-    out.i = i;
+    out.i = p_[i].id;
     out.time = now_;
     if (e.partner == kCage) {
       advance(i);
@@ -122,13 +145,15 @@ class SphereEngine {
       ++cages_;
       out.kind = Kind::cage;
       predict(i);
+      prefetch_next();
       return out;
     }
     const std::uint32_t j = e.partner;
-    out.j = j;
+    out.j = p_[j].id;
     if (p_[j].count != e.partner_count) {
       ++stale_;
       predict(i);
+      prefetch_next();
       return out;
     }
     advance(i);
@@ -138,6 +163,7 @@ class SphereEngine {
     out.kind = Kind::collision;
     predict(i);
     predict(j);
+    prefetch_next();
     return out;
   }
 
@@ -148,17 +174,19 @@ class SphereEngine {
     for (std::size_t i = 0; i < p_.size(); ++i) {
       const Sph& q = p_[i];
       const double dt = now_ - q.t;
-      s.r[i] = Vec3(wrap(q.x + q.vx * dt, 0), wrap(q.y + q.vy * dt, 1), wrap(q.z + q.vz * dt, 2));
-      s.v[i] = Vec3(q.vx, q.vy, q.vz);
-      s.t[i] = now_;
+      s.r[q.id] = Vec3(wrap(q.x + q.vx * dt, 0), wrap(q.y + q.vy * dt, 1), wrap(q.z + q.vz * dt, 2));
+      s.v[q.id] = Vec3(q.vx, q.vy, q.vz);
+      s.t[q.id] = now_;
     }
     return s;
   }
 
-  // Bytes of the per-sphere arrays (the memory figure of the benchmark).
+  // Bytes held per sphere (every array, the cell heads and the calendar included).
   std::size_t bytes_per_sphere() const {
-    return sizeof(Sph) + sizeof(Vec3) + kMaxNeighbours * sizeof(std::uint32_t) + sizeof(Ev) +
-           sizeof(Node) + sizeof(std::uint32_t) /*pos*/ + sizeof(std::uint32_t) /*next*/;
+    const std::size_t b = p_.capacity() * sizeof(Sph) + cage_.capacity() * sizeof(Vec3) +
+                          nb_.capacity() * sizeof(std::uint32_t) + ev_.capacity() * sizeof(Ev) +
+                          q_.bytes() + (head_.capacity() + next_.capacity()) * sizeof(std::uint32_t);
+    return p_.empty() ? 0 : (b + p_.size() - 1) / p_.size();
   }
 
  private:
@@ -166,31 +194,40 @@ class SphereEngine {
   struct alignas(64) Sph {
     double x, y, z, t;     // position at the own clock t
     double vx, vy, vz;
-    std::uint32_t count;   // velocity changes so far
-    std::uint32_t nn;      // neighbours listed
+    std::uint32_t id;          // the sphere's input number
+    std::uint32_t count : 24;  // velocity changes so far, modulo 2^24 (see Ev)
+    std::uint32_t nn : 8;      // neighbours listed
   };
+  static_assert(kMaxNeighbours < 256, "nn has 8 bits");
+  // A collision event holds the partner's count at prediction; it is stale once the partner's
+  // count moved on (a wrap of 2^24 velocity changes of the partner within one event's lifetime
+  // is out of reach: an event lives shorter than the owner's cage exit).
   struct Ev {
     std::uint32_t partner = kCage, partner_count = 0;
   };
-  struct Node {
-    double time;
-    std::uint32_t id;
-  };
 
-  double wrap(double x, int k) const {
-    if (x >= L_[k]) x -= L_[k];
-    else if (x < 0.0) x += L_[k];
-    return x;  // one box length at most: positions move less than a cage between wraps
-  }
-  double image(double d, int k) const {
-    if (d > hL_[k]) d -= L_[k];
-    else if (d < -hL_[k]) d += L_[k];
-    return d;
+  // Positions move less than a cage between wraps, separations are between spheres in the box.
+  double wrap(double x, int k) const { return wrap_once(x, L_[k]); }
+  double image(double d, int k) const { return image_once(d, L_[k], hL_[k]); }
+  // Cell index along axis k of a coordinate in [0, L) (the last cell takes x = L by rounding).
+  int axis_cell(double x, int k) const {
+    return std::min(ncell_[k] - 1, static_cast<int>(x / cell_len_[k]));
   }
   std::uint32_t cell_of(const Vec3& c) const {
     int idx[3];
-    for (int k = 0; k < 3; ++k) idx[k] = std::min(ncell_[k] - 1, static_cast<int>(c[k] / cell_len_[k]));
+    for (int k = 0; k < 3; ++k) idx[k] = axis_cell(c[k], k);
     return std::uint32_t((idx[2] * ncell_[1] + idx[1]) * ncell_[0] + idx[0]);
+  }
+
+  // Ask for the next event's records while this step's work is retiring (they miss at large N).
+  void prefetch_next() {
+    const std::uint32_t i = q_.top();
+    __builtin_prefetch(&p_[i]);
+    __builtin_prefetch(&ev_[i]);
+    __builtin_prefetch(&cage_[i]);
+    __builtin_prefetch(&nb_[std::size_t(i) * kMaxNeighbours]);
+    const std::uint32_t j = ev_[i].partner;
+    if (j != kCage) __builtin_prefetch(&p_[j]);
   }
 
   void advance(std::uint32_t i) {
@@ -207,15 +244,19 @@ class SphereEngine {
   void fill_list(std::uint32_t i, bool only_higher) {
     const Vec3& ci = cage_[i];
     const double reach2 = (sigma_ + shell_) * (sigma_ + shell_);
-    int idx[3];
-    for (int k = 0; k < 3; ++k) idx[k] = std::min(ncell_[k] - 1, static_cast<int>(ci[k] / cell_len_[k]));
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int cx = (idx[0] + dx + ncell_[0]) % ncell_[0];
-          const int cy = (idx[1] + dy + ncell_[1]) % ncell_[1];
-          const int cz = (idx[2] + dz + ncell_[2]) % ncell_[2];
-          for (std::uint32_t j = head_[(cz * ncell_[1] + cy) * ncell_[0] + cx]; j != kNone; j = next_[j]) {
+    // the three wrapped cell indices along each axis (no division in the loop)
+    int around[3][3];
+    for (int k = 0; k < 3; ++k) {
+      const int c = axis_cell(ci[k], k);
+      around[k][0] = c == 0 ? ncell_[k] - 1 : c - 1;
+      around[k][1] = c;
+      around[k][2] = c == ncell_[k] - 1 ? 0 : c + 1;
+    }
+    for (int dz = 0; dz < 3; ++dz)
+      for (int dy = 0; dy < 3; ++dy) {
+        const int row = (around[2][dz] * ncell_[1] + around[1][dy]) * ncell_[0];
+        for (int dx = 0; dx < 3; ++dx) {
+          for (std::uint32_t j = head_[row + around[0][dx]]; j != kNone; j = next_[j]) {
             if (j == i || (only_higher && j < i)) continue;
             const Vec3& cj = cage_[j];
             const double ex = image(cj.x() - ci.x(), 0), ey = image(cj.y() - ci.y(), 1),
@@ -226,20 +267,24 @@ class SphereEngine {
             }
           }
         }
+      }
   }
   void push(std::uint32_t i, std::uint32_t j) {
-    std::uint32_t& nn = p_[i].nn;
+    const std::uint32_t nn = p_[i].nn;
     if (nn == kMaxNeighbours)
       throw std::runtime_error("SphereEngine: more than " + std::to_string(kMaxNeighbours) +
-                               " neighbours of sphere " + std::to_string(i) + "; use a smaller shell");
-    nb_[std::size_t(i) * kMaxNeighbours + nn++] = j;
+                               " neighbours of sphere " + std::to_string(p_[i].id) +
+                               "; use a smaller shell");
+    nb_[std::size_t(i) * kMaxNeighbours + nn] = j;
+    p_[i].nn = nn + 1;
   }
   void remove(std::uint32_t j, std::uint32_t i) {  // i from j's list
     std::uint32_t* l = &nb_[std::size_t(j) * kMaxNeighbours];
-    std::uint32_t& nn = p_[j].nn;
+    const std::uint32_t nn = p_[j].nn;
     for (std::uint32_t k = 0; k < nn; ++k)
       if (l[k] == i) {
-        l[k] = l[--nn];
+        l[k] = l[nn - 1];
+        p_[j].nn = nn - 1;
         return;
       }
   }
@@ -247,7 +292,12 @@ class SphereEngine {
   // Sphere i (advanced to now) takes a new cage at its position.
   void new_cage(std::uint32_t i) {
     const std::uint32_t* l = &nb_[std::size_t(i) * kMaxNeighbours];
-    for (std::uint32_t k = 0; k < p_[i].nn; ++k) remove(l[k], i);
+    const std::uint32_t nn = p_[i].nn;
+    for (std::uint32_t k = 0; k < nn; ++k) {  // the lists and counts about to be edited
+      __builtin_prefetch(&nb_[std::size_t(l[k]) * kMaxNeighbours]);
+      __builtin_prefetch(&p_[l[k]]);
+    }
+    for (std::uint32_t k = 0; k < nn; ++k) remove(l[k], i);
     p_[i].nn = 0;
     const std::uint32_t c_old = cell_of(cage_[i]);
     cage_[i] = Vec3(p_[i].x, p_[i].y, p_[i].z);
@@ -262,17 +312,82 @@ class SphereEngine {
     fill_list(i, false);
   }
 
+  // Morton code of a cell: the bits of its three indices interleaved.
+  static std::uint64_t morton(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+    std::uint64_t m = 0;
+    for (int b = 0; b < 21; ++b)
+      m |= (std::uint64_t((x >> b) & 1u) << (3 * b)) | (std::uint64_t((y >> b) & 1u) << (3 * b + 1)) |
+           (std::uint64_t((z >> b) & 1u) << (3 * b + 2));
+    return m;
+  }
+  // Put the records in Morton order of their cage centres' cells and renumber everything that
+  // names a record: lists, events, the calendar's slots and the cell lists.
+  void reorder() {
+    const std::uint32_t n = static_cast<std::uint32_t>(p_.size());
+    next_reorder_ = reorder_every_ == 0 ? ~std::uint64_t(0) : events_ + reorder_every_;
+    std::vector<std::uint64_t> key(n);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      std::uint32_t idx[3];
+      for (int k = 0; k < 3; ++k)
+        idx[k] = std::uint32_t(axis_cell(cage_[i][k], k));
+      key[i] = morton(idx[0], idx[1], idx[2]);
+    }
+    std::vector<std::uint32_t> perm(n), inv(n);
+    for (std::uint32_t i = 0; i < n; ++i) perm[i] = i;
+    std::stable_sort(perm.begin(), perm.end(),
+                     [&](std::uint32_t a, std::uint32_t b) { return key[a] < key[b]; });
+    for (std::uint32_t k = 0; k < n; ++k) inv[perm[k]] = k;
+    // In place, cycle by cycle (the only copies are the keys, the permutation and the times).
+    std::vector<double> time(n);
+    for (std::uint32_t k = 0; k < n; ++k) time[k] = q_.time_of(perm[k]);
+    std::vector<bool> done(n, false);
+    std::uint32_t block[kMaxNeighbours];
+    for (std::uint32_t s = 0; s < n; ++s) {
+      if (done[s]) continue;
+      const Sph ps = p_[s];
+      const Vec3 cs = cage_[s];
+      const Ev es = ev_[s];
+      std::copy_n(&nb_[std::size_t(s) * kMaxNeighbours], kMaxNeighbours, block);
+      std::uint32_t k = s;
+      for (;;) {  // record k takes record perm[k]
+        done[k] = true;
+        const std::uint32_t from = perm[k];
+        if (from == s) {
+          p_[k] = ps, cage_[k] = cs, ev_[k] = es;
+          std::copy_n(block, kMaxNeighbours, &nb_[std::size_t(k) * kMaxNeighbours]);
+          break;
+        }
+        p_[k] = p_[from], cage_[k] = cage_[from], ev_[k] = ev_[from];
+        std::copy_n(&nb_[std::size_t(from) * kMaxNeighbours], kMaxNeighbours,
+                    &nb_[std::size_t(k) * kMaxNeighbours]);
+        k = from;
+      }
+    }
+    for (std::uint32_t k = 0; k < n; ++k) {  // renumber the references
+      std::uint32_t* l = &nb_[std::size_t(k) * kMaxNeighbours];
+      for (std::uint32_t m = 0; m < p_[k].nn; ++m) l[m] = inv[l[m]];
+      if (ev_[k].partner != kCage) ev_[k].partner = inv[ev_[k].partner];
+    }
+    q_.reset(n, q_.width(), q_.lists(), now_);
+    for (std::uint32_t k = 0; k < n; ++k) q_.set(k, time[k]);
+    std::fill(head_.begin(), head_.end(), kNone);
+    for (std::uint32_t k = n; k-- > 0;) {  // each cell's chain in increasing record order
+      const std::uint32_t c = cell_of(cage_[k]);
+      next_[k] = head_[c];
+      head_[c] = k;
+    }
+  }
+
   void collide(std::uint32_t i, std::uint32_t j) {
     Sph& a = p_[i];
     Sph& b = p_[j];
-    const double rx = image(b.x - a.x, 0), ry = image(b.y - a.y, 1), rz = image(b.z - a.z, 2);
-    const double inv = 1.0 / std::sqrt(rx * rx + ry * ry + rz * rz);
-    const double nx = rx * inv, ny = ry * inv, nz = rz * inv;
-    const double dvn = (b.vx - a.vx) * nx + (b.vy - a.vy) * ny + (b.vz - a.vz) * nz;
-    a.vx += dvn * nx, a.vy += dvn * ny, a.vz += dvn * nz;
-    b.vx -= dvn * nx, b.vy -= dvn * ny, b.vz -= dvn * nz;
-    ++a.count;
-    ++b.count;
+    const Vec3 r(image(b.x - a.x, 0), image(b.y - a.y, 1), image(b.z - a.z, 2));
+    Vec3 va(a.vx, a.vy, a.vz), vb(b.vx, b.vy, b.vz);
+    collide_spheres(va, vb, r / r.norm(), 1.0, 1.0);  // equal masses
+    a.vx = va.x(), a.vy = va.y(), a.vz = va.z();
+    b.vx = vb.x(), b.vy = vb.y(), b.vz = vb.z();
+    a.count = a.count + 1;  // modulo 2^24
+    b.count = b.count + 1;
   }
 
   // Earliest event of sphere i: its cage exit or a collision with a listed sphere.
@@ -293,7 +408,10 @@ class SphereEngine {
     std::uint32_t partner = kCage;
     const double s2 = sigma_ * sigma_;
     const std::uint32_t* l = &nb_[std::size_t(i) * kMaxNeighbours];
-    for (std::uint32_t k = 0; k < a.nn; ++k) {
+    const std::uint32_t nn = a.nn;
+    // The neighbours' records are the loads that miss at large N: ask for all of them at once.
+    for (std::uint32_t k = 0; k < nn; ++k) __builtin_prefetch(&p_[l[k]]);
+    for (std::uint32_t k = 0; k < nn; ++k) {
       const std::uint32_t j = l[k];
       const Sph& b = p_[j];
       const double dt = now_ - b.t;
@@ -302,9 +420,11 @@ class SphereEngine {
       const double ry = image(b.y + b.vy * dt - a.y, 1);
       const double rz = image(b.z + b.vz * dt - a.z, 2);
       const double bb = rx * dvx + ry * dvy + rz * dvz;
-      if (bb >= 0.0) continue;  // receding
       const double cc = rx * rx + ry * ry + rz * rz - s2;
-      if (cc >= -2.0 * bb * best) continue;  // t >= c / (-2b) >= best: cannot win
+      // Receding (bb >= 0), or t >= c / (-2b) >= best: cannot win.  One branch for both tests
+      // (non-short-circuit &): about half the pairs recede, at random, so a branch of its own
+      // is mispredicted often; most pairs fail one test or the other, so this one rarely passes.
+      if (!((bb < 0.0) & (cc < -2.0 * bb * best))) continue;
       double t;
       if (cc <= 0.0) {
         t = 0.0;  // touching to rounding and approaching: collide now
@@ -317,39 +437,7 @@ class SphereEngine {
       if (t < best) best = t, partner = j;
     }
     ev_[i] = Ev{partner, partner == kCage ? 0u : p_[partner].count};
-    set_time(i, now_ + best);
-  }
-
-  // Heap of (time, sphere) with positions pos_.
-  void set_time(std::uint32_t i, double t) {
-    std::uint32_t k = pos_[i];
-    const double old = heap_[k].time;
-    const Node node{t, i};
-    const std::uint32_t n = static_cast<std::uint32_t>(heap_.size());
-    if (t < old) {
-      while (k > 0) {
-        const std::uint32_t up = (k - 1) >> 1;
-        if (!less(node, heap_[up])) break;
-        heap_[k] = heap_[up];
-        pos_[heap_[k].id] = k;
-        k = up;
-      }
-    } else {
-      for (;;) {
-        std::uint32_t ch = 2 * k + 1;
-        if (ch >= n) break;
-        if (ch + 1 < n && less(heap_[ch + 1], heap_[ch])) ++ch;
-        if (!less(heap_[ch], node)) break;
-        heap_[k] = heap_[ch];
-        pos_[heap_[k].id] = k;
-        k = ch;
-      }
-    }
-    heap_[k] = node;
-    pos_[i] = k;
-  }
-  static bool less(const Node& a, const Node& b) {
-    return a.time < b.time || (a.time == b.time && a.id < b.id);
+    q_.set(i, now_ + best);
   }
 
   Vec3 L_, hL_;
@@ -361,10 +449,10 @@ class SphereEngine {
   std::vector<Vec3> cage_;
   std::vector<std::uint32_t> nb_;
   std::vector<Ev> ev_;
-  std::vector<Node> heap_;
-  std::vector<std::uint32_t> pos_;
+  Calendar q_;
   std::vector<std::uint32_t> head_, next_;
   std::uint64_t collisions_ = 0, cages_ = 0, stale_ = 0;
+  std::uint64_t events_ = 0, reorder_every_ = 0, next_reorder_ = 0;
 };
 
 }  // namespace hb

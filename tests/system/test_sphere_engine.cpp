@@ -39,35 +39,39 @@ double energy(const State& s) {
 
 TEST(SphereEngine, SameCollisionsAsTheGenericLoop) {
   for (const double phi : {0.3, 0.5}) {
-    for (const double shell : {0.05, 0.3}) {
-      SphereSystemSpec spec;
-      spec.n = 500;
-      spec.phi = phi;
-      spec.seed = 3;
-      Box box;
-      const State start = hard_sphere_start(spec, box);
-      auto sim = make_hard_sphere_cell_simulation(spec);
-      SphereEngine fast(box, start, spec.sigma, shell);
-      int compared = 0;
-      double worst_dt = 0.0;
-      while (compared < 2000) {
-        StepInfo a;
-        do a = sim.step(kInf);
-        while (a.type != EventType::Collision || a.stale);
-        SphereEngine::Step b;
-        do b = fast.step();
-        while (b.kind != SphereEngine::Kind::collision);
-        const auto lo = [](std::uint32_t x, std::uint32_t y) { return std::min(x, y); };
-        const auto hi = [](std::uint32_t x, std::uint32_t y) { return std::max(x, y); };
-        ASSERT_EQ(lo(a.record.a, a.record.b), lo(b.i, b.j)) << "collision " << compared;
-        ASSERT_EQ(hi(a.record.a, a.record.b), hi(b.i, b.j)) << "collision " << compared;
-        worst_dt = std::max(worst_dt, std::abs(a.record.time - b.time));
-        ASSERT_NEAR(a.record.time, b.time, 1e-9 * (1.0 + a.record.time)) << "collision " << compared;
-        ++compared;
+    for (const double shell : {0.05, 0.3, 0.5}) {
+      for (const std::uint64_t reorder : {std::uint64_t(0), std::uint64_t(37)}) {
+        SphereSystemSpec spec;
+        spec.n = 500;
+        spec.phi = phi;
+        spec.seed = 3;
+        Box box;
+        const State start = hard_sphere_start(spec, box);
+        auto sim = make_hard_sphere_cell_simulation(spec);
+        SphereEngine fast(box, start, spec.sigma, shell);
+        fast.set_reorder_interval(reorder);  // records re-sorted every 37 events, or never again
+        int compared = 0;
+        double worst_dt = 0.0;
+        while (compared < 2000) {
+          StepInfo a;
+          do a = sim.step(kInf);
+          while (a.type != EventType::Collision || a.stale);
+          SphereEngine::Step b;
+          do b = fast.step();
+          while (b.kind != SphereEngine::Kind::collision);
+          const auto lo = [](std::uint32_t x, std::uint32_t y) { return std::min(x, y); };
+          const auto hi = [](std::uint32_t x, std::uint32_t y) { return std::max(x, y); };
+          ASSERT_EQ(lo(a.record.a, a.record.b), lo(b.i, b.j)) << "collision " << compared;
+          ASSERT_EQ(hi(a.record.a, a.record.b), hi(b.i, b.j)) << "collision " << compared;
+          worst_dt = std::max(worst_dt, std::abs(a.record.time - b.time));
+          ASSERT_NEAR(a.record.time, b.time, 1e-9 * (1.0 + a.record.time)) << "collision " << compared;
+          ++compared;
+        }
+        std::printf("  phi %.2f shell %.2f reorder %llu: %d collisions equal, largest time "
+                    "difference %.2e, %llu cage exits\n",
+                    phi, shell, (unsigned long long)reorder, compared, worst_dt,
+                    (unsigned long long)fast.cage_exits());
       }
-      std::printf("  phi %.2f shell %.2f: %d collisions equal, largest time difference %.2e, "
-                  "%llu cage exits\n",
-                  phi, shell, compared, worst_dt, (unsigned long long)fast.cage_exits());
     }
   }
 }
@@ -118,4 +122,9 @@ TEST(SphereEngine, RejectsBadInput) {
   Box walled = box;
   walled.periodic[2] = false;
   EXPECT_THROW(SphereEngine(walled, s2, 1.0, 0.2), std::invalid_argument);
+  EXPECT_THROW(SphereEngine(box, State{}, 1.0, 0.2), std::invalid_argument);  // no spheres
+  State rest = s2;  // nothing moves: no event ahead, said rather than run to time infinity
+  for (auto& v : rest.v) v = Vec3::Zero();
+  SphereEngine still(box, rest, 1.0, 0.2);
+  EXPECT_THROW(still.step(), std::runtime_error);
 }
