@@ -103,7 +103,10 @@
 //   6. the 8-equation system from the centre-line guess without SD;
 //   7. (shapes with a support function) the maximum over directions of the
 //      gap along a direction (support_maximum, below): a different algorithm, robust where the
-//      contact equations are singular along straight walls and flat faces.
+//      contact equations are singular along straight walls and flat faces;
+//   8. (shapes with a support function) the same maximum, global and certified by branch and
+//      bound (geometry/penetration.hpp): slow, the last resort where stage 7's local Newton
+//      stalls (nearly flat faces meeting at a collision).
 // If all fail the status is `failed` and the distance is the best upper bound found (the
 // separated-bodies SD estimate), never a silent value.
 #pragma once
@@ -114,6 +117,7 @@
 #include <cmath>
 #include <type_traits>
 
+#include "geometry/penetration.hpp"
 #include "geometry/posed.hpp"
 #include "math/types.hpp"
 #include "shapes/ellipsoid.hpp"
@@ -151,6 +155,7 @@ struct DistanceOptions {
   double sd_cos_fallback = 1.0 - 1e-10;
   double sd_lambda = 0.45;   // SD step: each point moves this fraction of the tangential gap
   bool analytic_spheres = true;  // sphere-sphere fast path (tested equal to the generic path)
+  bool global_stage = true;  // fallback stage 8, the certified global gap maximum (header)
 };
 
 // Previous solution of a pair: closest points in each body's own frame, and the multipliers.
@@ -174,7 +179,7 @@ struct DistanceResult {
   double alpha = 0.0, beta = 0.0;
   int nr_iterations = 0;        // total over all attempts
   int sd_iterations = 0;
-  int attempt = 0;              // stage that succeeded: 1 warm, 2 cold, 3-7 fallbacks (header)
+  int attempt = 0;              // stage that succeeded: 1 warm, 2 cold, 3-8 fallbacks (header)
   bool warm_used = false;
   DistanceWarmStart warm;       // feed back as the warm start of the next call for this pair
 };
@@ -785,7 +790,7 @@ DistanceResult distance(const SA& a, const Pose& pa, const SB& b, const Pose& pb
   Point p;
   bool ok = false;
   int stage = 0;  // 1 warm, 2 cold, 3 support points, 4 long SD + 8 eq, 5 five eq, 6 centre line,
-                  // 7 gap maximum over directions
+                  // 7 gap maximum over directions (local), 8 the same, global and certified
   auto run = [&](int st, Point start, DistanceSystem sys) {
     stage = st;
     p = start;
@@ -845,6 +850,29 @@ DistanceResult distance(const SA& a, const Pose& pa, const SB& b, const Pose& pb
       stage = 7;
       dual = ok = support_maximum(A, B, Vec3(xb - xa), o, sc, res.nr_iterations, p, G, n_dual);
       if (ok) res.attempt = 7;
+    }
+  }
+  // 8. (shapes with a support function) the same maximum found globally and certified by branch
+  // and bound over the sphere of directions (geometry/penetration.hpp), from the SD estimate's
+  // joining line and the failed NR's last normal.  Slow (hundreds to thousands of gap
+  // evaluations) and reached only when every local method failed: seen where nearly flat faces
+  // meet (superquadrics (2, 2, 16) face to face at a collision), where the contact equations are
+  // nearly singular and stage 7's Newton on the sphere stalls on the C^1 kink of G at a face
+  // normal.  For a flat contact the support points are one pair of many on the touching faces.
+  if constexpr (SupportShape<SA> && SupportShape<SB>) {
+    if (!ok && o.global_stage) {
+      stage = 8;
+      Vec3 hints[2] = {Vec3(xb - xa), A.grad(p.xa)};
+      const int nh = hints[1].allFinite() && hints[1].squaredNorm() > 0.0 ? 2 : 1;
+      const PenetrationResult g =
+          penetration(a, Pose{}, b, B.pose, std::span<const Vec3>(hints, std::size_t(nh)));
+      if (g.certified) {
+        dual = ok = true;
+        res.attempt = 8;
+        p = multipliers(A, B, g.point_a, g.point_b);
+        G = g.distance;
+        n_dual = g.normal;
+      }
     }
   }
   if (!ok) {  // report the SD estimate (an upper bound when separated), flagged as failed

@@ -1,8 +1,9 @@
 // Penetration depth of two convex bodies with support functions: the minimal translation that
 // separates them, and its points (the `hardbody distance` answer for overlapping pairs, DESIGN.md).
-// The simulation's distance solver (geometry/distance.hpp) is not changed by this file: it finds
-// *a* stationary point of the contact equations, which for slight overlaps is this one, but for
-// deep ones may be another (crossing needles, coincident bodies); this solver searches globally.
+// The simulation's distance solver (geometry/distance.hpp) finds *a* stationary point of the
+// contact equations, which for slight overlaps is this one, but for deep ones may be another
+// (crossing needles, coincident bodies); this solver searches globally.  The distance solver
+// uses it as its last fallback stage (8), where every local method failed.
 //
 // Derivation.  For a unit direction n the gap of the pair along n is
 //     G(n) = min_{y in B} n.y - max_{x in A} n.x = n.(r_B - r_A) - h_A(n) - h_B(-n),
