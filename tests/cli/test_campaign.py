@@ -2,9 +2,10 @@
 
 The small campaign examples/campaigns/spheres-small.toml (4 packing fractions x 3 seeds of 108
 hard spheres, about a second each) runs locally on 2 cores with Snakemake: results.csv matches
-every summary.json, a second invocation starts nothing, a campaign killed ten times (SIGTERM and
-SIGKILL at seeded random moments) completes on re-run with every run's final state identical to
-the uninterrupted campaign's, and a grid point with a config error is reported (message and
+every summary.json, a second invocation starts nothing, a campaign stopped once surely inside a
+run (the run frozen while the SIGTERM reaches it) and then killed ten times (SIGTERM and SIGKILL
+at seeded random moments) completes on re-run with every run's final state identical to the
+uninterrupted campaign's, and a grid point with a config error is reported (message and
 reproducer) without stopping the others. Release build only (label integration).
 """
 import csv
@@ -100,7 +101,8 @@ def test_rerun_starts_nothing(reference):
     assert s.returncode == 0 and "12 done, 0 running, 0 failed, 0 pending" in s.stdout, s.stdout
 
 
-def hardbody_processes(out: Path) -> list[str]:
+def hardbody_runs(out: Path) -> list[tuple[int, str]]:
+    """The live `hardbody run` processes of the campaign under `out`: (pid, command line)."""
     res = []
     for p in Path("/proc").iterdir():
         try:
@@ -109,14 +111,69 @@ def hardbody_processes(out: Path) -> list[str]:
         except (OSError, IndexError):
             continue
         if state != "Z" and any(str(out).encode() in a for a in cmd) and b"run" in cmd:
-            res.append(" ".join(a.decode() for a in cmd))
+            res.append((int(p.name), " ".join(a.decode() for a in cmd)))
     return res
+
+
+def hardbody_processes(out: Path) -> list[str]:
+    return [cmd for _, cmd in hardbody_runs(out)]
+
+
+def sigterm_pending(pid: int) -> bool:
+    """SIGTERM is pending for the process (it cannot act on it while stopped)."""
+    bit = 1 << (signal.SIGTERM - 1)
+    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+        if line.startswith(("SigPnd:", "ShdPnd:")) and int(line.split()[1], 16) & bit:
+            return True
+    return False
+
+
+def stop_campaign_inside_a_run(cfg: Path, out: Path, cwd: Path) -> str:
+    """SIGTERM to the campaign while one of its runs is surely in the middle of its work, whatever
+    the machine's speed: the run is frozen (SIGSTOP) once its signal handler is installed (it is
+    installed before config.resolved.toml is written) and before its summary is written, the
+    campaign is told to stop, and the run is thawed once the SIGTERM the campaign passes on is
+    pending. Returns the name of that run."""
+    p = subprocess.Popen([HB, "campaign", str(cfg)], cwd=cwd, stdout=subprocess.DEVNULL,
+                         stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    frozen = None
+    while frozen is None:
+        assert time.monotonic() < deadline and p.poll() is None, "no run started"
+        for pid, cmd in hardbody_runs(out):
+            run_dir = Path(shlex.split(cmd)[shlex.split(cmd).index("--out") + 1])
+            if not (run_dir / "config.resolved.toml").exists():
+                continue
+            try:
+                os.kill(pid, signal.SIGSTOP)
+            except ProcessLookupError:
+                continue
+            if (run_dir / "summary.json").exists():  # finishing: let it go, take another
+                os.kill(pid, signal.SIGCONT)
+                continue
+            frozen = (pid, run_dir.name)
+            break
+        time.sleep(0.01)
+    pid, name = frozen
+    p.send_signal(signal.SIGTERM)
+    while not sigterm_pending(pid):
+        assert time.monotonic() < deadline, "the campaign did not pass SIGTERM on to its run"
+        time.sleep(0.01)
+    os.kill(pid, signal.SIGCONT)
+    _, err = p.communicate(timeout=300)
+    assert p.returncode == 143, err
+    assert hardbody_processes(out) == [], err
+    return name
 
 
 def test_killed_campaign_completes_with_identical_runs(reference, tmp_path):
     ref_out, _ = reference
     cfg = copy_campaign(tmp_path)
     out = tmp_path / "spheres-small"
+    # one stop surely inside a run, then ten at seeded random moments (how many of those land
+    # inside a run depends on the machine's speed)
+    stopped = stop_campaign_inside_a_run(cfg, out, tmp_path)
+    assert "== exit 143" in (out / "logs" / f"{stopped}.log").read_text()
     rng = random.Random(14)
     for k in range(10):
         p = subprocess.Popen([HB, "campaign", str(cfg)], cwd=tmp_path, stdout=subprocess.DEVNULL,
@@ -135,9 +192,7 @@ def test_killed_campaign_completes_with_identical_runs(reference, tmp_path):
     r = campaign([str(cfg)], tmp_path)
     assert r.returncode == 0, r.stderr
     logs = "".join(p.read_text() for p in (out / "logs").glob("*.log"))
-    # runs were interrupted and resumed: how many of the kills land inside a run depends on the
-    # machine's speed (a clean-clone run on an idle machine saw 1 of 5 SIGTERMs stop a run, a
-    # loaded one 3 or more); the identity with the uninterrupted campaign below is the test
+    # runs were interrupted and resumed; the identity with the uninterrupted campaign is the test
     assert logs.count("== exit 143") >= 1, logs
     assert "--resume" in logs
     assert campaign_compare.compare(ref_out, out) == []
