@@ -221,6 +221,7 @@ class SphereEngine {
 
   // Ask for the next event's records while this step's work is retiring (they miss at large N).
   void prefetch_next() {
+    q_.prefetch_ahead();
     const std::uint32_t i = q_.top();
     __builtin_prefetch(&p_[i]);
     __builtin_prefetch(&ev_[i]);
