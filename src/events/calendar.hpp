@@ -96,7 +96,9 @@ class Calendar {
         idle = 0;
         continue;
       }
-      advance();
+      // a turn's end that re-placed slots (a rescan or a rebuild) may have put some in lists
+      // ahead: the idle count starts again, so the jump above never passes them by
+      if (advance()) idle = 0;
     }
     return heap_[0].id;
   }
@@ -166,14 +168,16 @@ class Calendar {
     else link_after(i, overflow());
   }
 
-  void advance() {
+  // Move to the next bucket; true if the turn's end re-placed any slot.
+  bool advance() {
     ++cur_;
     ++passed_;
-    if (cur_ % nb_ == 0) end_of_turn();
+    const bool moved = cur_ % nb_ == 0 && end_of_turn();
     pour(list_of(cur_));
     ahead_ = list_of(cur_ + 1);  // the sentinel: the walk starts at its first node
     ahead_ = link_[ahead_].next;
     if (ahead_ < n_) __builtin_prefetch(&link_[ahead_]);
+    return moved;
   }
   // Move every slot of list head into the heap.
   void pour(std::uint32_t head) {
@@ -186,28 +190,33 @@ class Calendar {
     link_[head] = Link{head, head};
   }
   // Overflow slots whose bucket came within reach go to their lists (or the heap).
-  void rescan_overflow() {
+  // Returns whether any moved.
+  bool rescan_overflow() {
     const std::uint32_t head = overflow();
     std::uint32_t i = link_[head].next;
+    bool moved = false;
     while (i != head) {
       const std::uint32_t nx = link_[i].next;
       const std::int64_t b = bucket(time_[i]);
       if (b - cur_ < static_cast<std::int64_t>(nb_)) {
         unlink(i);
         place(i, b);
+        moved = true;
       }
       i = nx;
     }
+    return moved;
   }
-  void end_of_turn() {
+  // Re-tunes the width or rescans the overflow; true if any slot was re-placed.
+  bool end_of_turn() {
     const double per_bucket = double(entries_) / std::max<std::uint64_t>(passed_, 1);
     const bool judged = 2 * passed_ >= nb_;
     entries_ = passed_ = 0;
     if (judged && per_bucket > 0.0 && (per_bucket < 1.5 || per_bucket > 24.0)) {
       rebuild(width_ * kPerBucket / per_bucket);
-      return;
+      return true;
     }
-    rescan_overflow();
+    return rescan_overflow();
   }
   // Every slot re-placed with a new width (cur becomes the bucket of the earliest time).
   void rebuild(double width) {
