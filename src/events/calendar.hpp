@@ -41,7 +41,7 @@ class Calendar {
     nb_ = lists < 1 ? 1 : lists;
     width_ = width;
     inv_w_ = 1.0 / width;
-    time_.assign(n, kInf);
+    slot_.assign(n, Slot{});
     link_.resize(std::size_t(n) + nb_ + 1);
     for (std::uint32_t s = 0; s <= nb_; ++s) link_[n + s] = Link{n + s, n + s};
     heap_.clear();
@@ -51,24 +51,29 @@ class Calendar {
   }
 
   std::uint32_t size() const { return n_; }
-  double time_of(std::uint32_t i) const { return time_[i]; }
+  double time_of(std::uint32_t i) const { return slot_[i].time; }
+  // The two numbers stored with slot i's time (the event's partner and the partner's stamp).
+  std::uint32_t tag_of(std::uint32_t i) const { return slot_[i].tag; }
+  std::uint32_t stamp_of(std::uint32_t i) const { return slot_[i].stamp; }
   double width() const { return width_; }
   std::uint32_t lists() const { return nb_; }
   // Bytes held, for the memory figure of the benchmarks.
   std::size_t bytes() const {
-    return time_.capacity() * sizeof(double) + link_.capacity() * sizeof(Link) +
+    return slot_.capacity() * sizeof(Slot) + link_.capacity() * sizeof(Link) +
            heap_.capacity() * sizeof(Node);
   }
 
-  // Set slot i's time (replacing its old one).
-  void set(std::uint32_t i, double t) {
+  // Set slot i's time (replacing its old one), with two numbers carried along: tag (also held
+  // in the heap, where it is known with the top without touching the slot) and stamp.
+  void set(std::uint32_t i, double t, std::uint32_t tag = 0, std::uint32_t stamp = 0) {
     const std::int64_t b = bucket(t);
     if (link_[i].next == kHeap) {
       const std::uint32_t k = link_[i].prev;
       if (b <= cur_) {  // stays in the heap
         const bool up = Node{t, i} < heap_[k];
-        time_[i] = t;
+        slot_[i] = Slot{t, tag, stamp};
         heap_[k].time = t;
+        heap_[k].tag = tag;
         if (up) sift_up(k); else sift_down(k);
         return;
       }
@@ -76,7 +81,7 @@ class Calendar {
     } else {
       unlink(i);
     }
-    time_[i] = t;
+    slot_[i] = Slot{t, tag, stamp};
     place(i, b);
   }
 
@@ -89,9 +94,9 @@ class Calendar {
     while (heap_.empty()) {
       if (++idle > nb_ + 1) {  // a whole turn without an event: all are in the overflow
         const std::uint32_t first = earliest_overflow();
-        if (first == kHeap || time_[first] == kInf) return first;  // nothing finite ahead
+        if (first == kHeap || slot_[first].time == kInf) return first;  // nothing finite ahead
         ++jumps_;
-        cur_ = bucket(time_[first]);  // jump to it (the overflow keeps b >= cur + nb)
+        cur_ = bucket(slot_[first].time);  // jump to it (the overflow keeps b >= cur + nb)
         rescan_overflow();
         idle = 0;
         continue;
@@ -106,6 +111,17 @@ class Calendar {
   // Re-place every slot with buckets of a new width (O(N)).
   void set_width(double width) { rebuild(width); }
 
+  // After top(): the tag of the top slot, read from the heap (no access to the slot).
+  std::uint32_t top_tag() const { return heap_.empty() ? 0u : heap_[0].tag; }
+  // After top(): the heap entries that come next unless a new time is set before them (the root's
+  // children), a hint for asking their data from memory one event ahead.  Writes up to 2 (slot,
+  // tag) pairs and returns how many.
+  int next_after_top(std::uint32_t slot[2], std::uint32_t tag[2]) const {
+    int m = 0;
+    for (std::size_t k = 1; k <= 2 && k < heap_.size(); ++k, ++m) slot[m] = heap_[k].id, tag[m] = heap_[k].tag;
+    return m;
+  }
+
   // A hint for large calendars, once per event: one more node of the next bucket's list is asked
   // for from memory.  Pouring a list into the heap follows its links, one cache miss after the
   // other when the slots are spread over a large memory; walked ahead one node per event, the
@@ -118,7 +134,7 @@ class Calendar {
     ahead_ = nx;
     if (nx < n_) {
       __builtin_prefetch(&link_[nx]);
-      __builtin_prefetch(&time_[nx]);
+      __builtin_prefetch(&slot_[nx]);
     }
   }
 
@@ -133,9 +149,13 @@ class Calendar {
   struct Link {
     std::uint32_t prev, next;  // in the heap: prev = heap position, next = kHeap
   };
-  struct Node {
+  struct Slot {
+    double time = kInf;
+    std::uint32_t tag = 0, stamp = 0;
+  };
+  struct Node {  // 16 bytes, the tag in what would be padding
     double time;
-    std::uint32_t id;
+    std::uint32_t id, tag = 0;
     bool operator<(const Node& o) const { return time < o.time || (time == o.time && id < o.id); }
   };
 
@@ -197,7 +217,7 @@ class Calendar {
     bool moved = false;
     while (i != head) {
       const std::uint32_t nx = link_[i].next;
-      const std::int64_t b = bucket(time_[i]);
+      const std::int64_t b = bucket(slot_[i].time);
       if (b - cur_ < static_cast<std::int64_t>(nb_)) {
         unlink(i);
         place(i, b);
@@ -223,25 +243,25 @@ class Calendar {
     ++rebuilds_;
     since_rebuild_ = entries_ = passed_ = 0;
     double first = kInf;
-    for (std::uint32_t i = 0; i < n_; ++i) first = std::min(first, time_[i]);
+    for (std::uint32_t i = 0; i < n_; ++i) first = std::min(first, slot_[i].time);
     width_ = width;
     inv_w_ = 1.0 / width;
     std::vector<Node>().swap(heap_);  // release a heap grown under a width far too large
     for (std::uint32_t s = 0; s <= nb_; ++s) link_[n_ + s] = Link{n_ + s, n_ + s};
     cur_ = first < kInf ? bucket(first) : 0;
-    for (std::uint32_t i = 0; i < n_; ++i) place(i, bucket(time_[i]));
+    for (std::uint32_t i = 0; i < n_; ++i) place(i, bucket(slot_[i].time));
   }
   // The least (time, slot) of the overflow (kHeap if it is empty).
   std::uint32_t earliest_overflow() const {
     const std::uint32_t head = overflow();
     std::uint32_t best = kHeap;
     for (std::uint32_t i = link_[head].next; i != head; i = link_[i].next)
-      if (best == kHeap || Node{time_[i], i} < Node{time_[best], best}) best = i;
+      if (best == kHeap || Node{slot_[i].time, i} < Node{slot_[best].time, best}) best = i;
     return best;
   }
 
   void heap_push(std::uint32_t i) {
-    heap_.push_back(Node{time_[i], i});
+    heap_.push_back(Node{slot_[i].time, i, slot_[i].tag});
     link_[i].next = kHeap;
     sift_up(static_cast<std::uint32_t>(heap_.size() - 1));
     ++entries_;
@@ -290,7 +310,7 @@ class Calendar {
   std::uint64_t entries_ = 0, passed_ = 0;  // heap entries and buckets passed this turn
   std::uint64_t since_rebuild_ = 0;         // heap entries since the last rebuild
   std::uint32_t ahead_ = 0xffffffffu;       // prefetch_ahead's position in the next list
-  std::vector<double> time_;
+  std::vector<Slot> slot_;
   std::vector<Link> link_;
   std::vector<Node> heap_;
 };

@@ -100,7 +100,6 @@ class SphereEngine {
       head_[c] = i;
     }
     for (std::uint32_t i = 0; i < n; ++i) fill_list(i, /*only_higher=*/true);
-    ev_.resize(n);
     const std::uint32_t lists = std::max<std::uint32_t>(16, std::uint32_t(n / 4));  // 2 B/sphere
     q_.reset(static_cast<std::uint32_t>(n), 1.0, lists, now);
     for (std::uint32_t i = 0; i < n; ++i) predict(i);
@@ -132,14 +131,14 @@ class SphereEngine {
     if (events_ >= next_reorder_) reorder();
     ++events_;
     const std::uint32_t i = q_.top();
-    const Ev e = ev_[i];
+    const std::uint32_t partner = q_.tag_of(i), partner_count = q_.stamp_of(i);
     if (!(q_.time_of(i) < kInf))
       throw std::runtime_error("SphereEngine: no event ahead (every sphere is at rest)");
     now_ = q_.time_of(i);
     Step out;
     out.i = p_[i].id;
     out.time = now_;
-    if (e.partner == kCage) {
+    if (partner == kCage) {
       advance(i);
       new_cage(i);
       ++cages_;
@@ -148,9 +147,9 @@ class SphereEngine {
       prefetch_next();
       return out;
     }
-    const std::uint32_t j = e.partner;
+    const std::uint32_t j = partner;
     out.j = p_[j].id;
-    if (p_[j].count != e.partner_count) {
+    if (p_[j].count != partner_count) {
       ++stale_;
       predict(i);
       prefetch_next();
@@ -184,7 +183,7 @@ class SphereEngine {
   // Bytes held per sphere (every array, the cell heads and the calendar included).
   std::size_t bytes_per_sphere() const {
     const std::size_t b = p_.capacity() * sizeof(Sph) + cage_.capacity() * sizeof(Vec3) +
-                          nb_.capacity() * sizeof(std::uint32_t) + ev_.capacity() * sizeof(Ev) +
+                          nb_.capacity() * sizeof(std::uint32_t) +
                           q_.bytes() + (head_.capacity() + next_.capacity()) * sizeof(std::uint32_t);
     return p_.empty() ? 0 : (b + p_.size() - 1) / p_.size();
   }
@@ -195,16 +194,14 @@ class SphereEngine {
     double x, y, z, t;     // position at the own clock t
     double vx, vy, vz;
     std::uint32_t id;          // the sphere's input number
-    std::uint32_t count : 24;  // velocity changes so far, modulo 2^24 (see Ev)
+    std::uint32_t count : 24;  // velocity changes so far, modulo 2^24 (see below)
     std::uint32_t nn : 8;      // neighbours listed
   };
   static_assert(kMaxNeighbours < 256, "nn has 8 bits");
-  // A collision event holds the partner's count at prediction; it is stale once the partner's
-  // count moved on (a wrap of 2^24 velocity changes of the partner within one event's lifetime
-  // is out of reach: an event lives shorter than the owner's cage exit).
-  struct Ev {
-    std::uint32_t partner = kCage, partner_count = 0;
-  };
+  // Sphere i's event is its time in the calendar, with the partner (kCage for a cage exit) as its
+  // tag and the partner's count at prediction as its stamp; it is stale once the partner's count
+  // moved on (a wrap of 2^24 velocity changes of the partner within one event's lifetime is out
+  // of reach: an event lives shorter than the owner's cage exit).
 
   // Positions move less than a cage between wraps, separations are between spheres in the box.
   double wrap(double x, int k) const { return wrap_once(x, L_[k]); }
@@ -219,16 +216,22 @@ class SphereEngine {
     return std::uint32_t((idx[2] * ncell_[1] + idx[1]) * ncell_[0] + idx[0]);
   }
 
-  // Ask for the next event's records while this step's work is retiring (they miss at large N).
+  // Ask for the records of the next event, and of the two the calendar puts after it, while this
+  // step's work is retiring (they miss at large N).  The partners are the calendar's tags, held
+  // in its heap: no load waits on a miss here.
   void prefetch_next() {
     q_.prefetch_ahead();
     const std::uint32_t i = q_.top();
+    prefetch_event(i, q_.top_tag());
+    std::uint32_t slot[2], tag[2];
+    const int m = q_.next_after_top(slot, tag);
+    for (int k = 0; k < m; ++k) prefetch_event(slot[k], tag[k]);
+  }
+  void prefetch_event(std::uint32_t i, std::uint32_t partner) {
     __builtin_prefetch(&p_[i]);
-    __builtin_prefetch(&ev_[i]);
     __builtin_prefetch(&cage_[i]);
     __builtin_prefetch(&nb_[std::size_t(i) * kMaxNeighbours]);
-    const std::uint32_t j = ev_[i].partner;
-    if (j != kCage) __builtin_prefetch(&p_[j]);
+    if (partner != kCage) __builtin_prefetch(&p_[partner]);
   }
 
   void advance(std::uint32_t i) {
@@ -338,27 +341,33 @@ class SphereEngine {
     std::stable_sort(perm.begin(), perm.end(),
                      [&](std::uint32_t a, std::uint32_t b) { return key[a] < key[b]; });
     for (std::uint32_t k = 0; k < n; ++k) inv[perm[k]] = k;
-    // In place, cycle by cycle (the only copies are the keys, the permutation and the times).
-    std::vector<double> time(n);
-    for (std::uint32_t k = 0; k < n; ++k) time[k] = q_.time_of(perm[k]);
+    // In place, cycle by cycle (the only copies are the keys, the permutation and the events).
+    struct Event {
+      double time;
+      std::uint32_t partner, count;
+    };
+    std::vector<Event> event(n);
+    for (std::uint32_t k = 0; k < n; ++k) {
+      const std::uint32_t from = perm[k], partner = q_.tag_of(from);
+      event[k] = Event{q_.time_of(from), partner == kCage ? kCage : inv[partner], q_.stamp_of(from)};
+    }
     std::vector<bool> done(n, false);
     std::uint32_t block[kMaxNeighbours];
     for (std::uint32_t s = 0; s < n; ++s) {
       if (done[s]) continue;
       const Sph ps = p_[s];
       const Vec3 cs = cage_[s];
-      const Ev es = ev_[s];
       std::copy_n(&nb_[std::size_t(s) * kMaxNeighbours], kMaxNeighbours, block);
       std::uint32_t k = s;
       for (;;) {  // record k takes record perm[k]
         done[k] = true;
         const std::uint32_t from = perm[k];
         if (from == s) {
-          p_[k] = ps, cage_[k] = cs, ev_[k] = es;
+          p_[k] = ps, cage_[k] = cs;
           std::copy_n(block, kMaxNeighbours, &nb_[std::size_t(k) * kMaxNeighbours]);
           break;
         }
-        p_[k] = p_[from], cage_[k] = cage_[from], ev_[k] = ev_[from];
+        p_[k] = p_[from], cage_[k] = cage_[from];
         std::copy_n(&nb_[std::size_t(from) * kMaxNeighbours], kMaxNeighbours,
                     &nb_[std::size_t(k) * kMaxNeighbours]);
         k = from;
@@ -367,10 +376,9 @@ class SphereEngine {
     for (std::uint32_t k = 0; k < n; ++k) {  // renumber the references
       std::uint32_t* l = &nb_[std::size_t(k) * kMaxNeighbours];
       for (std::uint32_t m = 0; m < p_[k].nn; ++m) l[m] = inv[l[m]];
-      if (ev_[k].partner != kCage) ev_[k].partner = inv[ev_[k].partner];
     }
     q_.reset(n, q_.width(), q_.lists(), now_);
-    for (std::uint32_t k = 0; k < n; ++k) q_.set(k, time[k]);
+    for (std::uint32_t k = 0; k < n; ++k) q_.set(k, event[k].time, event[k].partner, event[k].count);
     std::fill(head_.begin(), head_.end(), kNone);
     for (std::uint32_t k = n; k-- > 0;) {  // each cell's chain in increasing record order
       const std::uint32_t c = cell_of(cage_[k]);
@@ -437,8 +445,7 @@ class SphereEngine {
       }
       if (t < best) best = t, partner = j;
     }
-    ev_[i] = Ev{partner, partner == kCage ? 0u : p_[partner].count};
-    q_.set(i, now_ + best);
+    q_.set(i, now_ + best, partner, partner == kCage ? 0u : std::uint32_t(p_[partner].count));
   }
 
   Vec3 L_, hL_;
@@ -449,7 +456,6 @@ class SphereEngine {
   std::vector<Sph> p_;
   std::vector<Vec3> cage_;
   std::vector<std::uint32_t> nb_;
-  std::vector<Ev> ev_;
   Calendar q_;
   std::vector<std::uint32_t> head_, next_;
   std::uint64_t collisions_ = 0, cages_ = 0, stale_ = 0;

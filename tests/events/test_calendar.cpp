@@ -16,6 +16,7 @@ namespace {
 
 struct Brute {
   std::vector<double> t;
+  std::vector<std::uint32_t> tag, stamp;  // carried with each time
   std::uint32_t top() const {
     std::uint32_t b = 0;
     for (std::uint32_t i = 1; i < t.size(); ++i)
@@ -25,7 +26,7 @@ struct Brute {
 };
 
 // A discrete-event run: pop the top, give it a new time ahead, and move a few others; returns
-// the number of pops compared.
+// the number of pops compared.  The tags and stamps set with the times must come back with them.
 struct Drive {
   int compared = 0;
   std::uint64_t rebuilds = 0, jumps = 0;
@@ -37,12 +38,22 @@ Drive drive(std::uint32_t n, double width, std::uint32_t lists, std::uint64_t se
   q.reset(n, width, lists, 0.0);
   Brute b;
   b.t.assign(n, Calendar::kInf);
+  b.tag.assign(n, 0);
+  b.stamp.assign(n, 0);
   pcg32 rng(seed);
   std::uniform_int_distribution<std::uint32_t> pick(0, n - 1);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::exponential_distribution<double> ex(1.0 / mean_dt);
   std::uniform_int_distribution<int> coarse(0, 5);
   double now = 0.0;
+  // every set carries a fresh tag and stamp, kept by the twin too
+  auto set = [&](std::uint32_t i, double t) {
+    const std::uint32_t tag = rng(), stamp = rng();
+    q.set(i, t, tag, stamp);
+    b.t[i] = t;
+    b.tag[i] = tag;
+    b.stamp[i] = stamp;
+  };
   auto draw = [&]() {
     const double r = u(rng);
     if (r < inf_fraction) return Calendar::kInf;
@@ -51,39 +62,48 @@ Drive drive(std::uint32_t n, double width, std::uint32_t lists, std::uint64_t se
     return now + ex(rng);
   };
   for (std::uint32_t i = 0; i < n; ++i) {
-    const double t = draw();
-    q.set(i, t);
-    b.t[i] = t;
+    set(i, draw());
   }
   int& compared = out.compared;
   for (int k = 0; k < pops; ++k) {
     q.prefetch_ahead();  // a hint that walks the next list: it must never change what pops
     const std::uint32_t top = q.top();
     if (top != b.top()) {
-      ADD_FAILURE() << "pop " << k << ": calendar top " << top << " at " << q.time_of(top)
+      ADD_FAILURE() << "pop " << k << ": calendar top " << top << " at " << (top < n ? q.time_of(top) : -1.0)
                     << ", brute top " << b.top() << " at " << b.t[b.top()];
       return out;
     }
     ++compared;
+    if (q.tag_of(top) != b.tag[top] || q.stamp_of(top) != b.stamp[top]) {
+      ADD_FAILURE() << "pop " << k << ": slot " << top << " lost its tag or stamp";
+      return out;
+    }
+    if (b.t[top] < Calendar::kInf) {  // finite: the top is in the heap, with its tag
+      if (q.top_tag() != b.tag[top]) {
+        ADD_FAILURE() << "pop " << k << ": the heap's tag of the top differs";
+        return out;
+      }
+      std::uint32_t slot[2], tag[2];
+      const int m = q.next_after_top(slot, tag);
+      for (int c = 0; c < m; ++c)  // hints: slots after the top, with their own tags
+        if (slot[c] == top || slot[c] >= n || tag[c] != b.tag[slot[c]] || b.t[slot[c]] < b.t[top]) {
+          ADD_FAILURE() << "pop " << k << ": bad hint " << slot[c];
+          return out;
+        }
+    }
     if (b.t[top] == Calendar::kInf) {  // nothing finite ahead: revive a few
       for (int m = 0; m < 3; ++m) {
         const std::uint32_t i = pick(rng);
-        const double t = now + ex(rng);
-        q.set(i, t);
-        b.t[i] = t;
+        set(i, now + ex(rng));
       }
       continue;
     }
     now = b.t[top];
-    double t = draw();
-    q.set(top, t);
-    b.t[top] = t;
+    set(top, draw());
     const int others = static_cast<int>(u(rng) * 3);
     for (int m = 0; m < others; ++m) {  // partners re-predicted (earlier or later)
       const std::uint32_t i = pick(rng);
-      t = u(rng) < 0.1 ? now : draw();
-      q.set(i, t);
-      b.t[i] = t;
+      set(i, u(rng) < 0.1 ? now : draw());
     }
   }
   out.rebuilds = q.rebuilds();
@@ -168,9 +188,11 @@ TEST(Calendar, EqualTimesPopInSlotOrder) {
 TEST(Calendar, SlotBroughtIntoReachAtTheEndOfAnIdleTurnIsNotPassedBy) {
   Calendar q;
   q.reset(1, 1.0, 4, 0.0);  // buckets of width 1, lists for buckets 1..3 ahead
-  q.set(0, 6.5);      // bucket 6: the overflow; the rescan at bucket 4 moves it to a list
+  q.set(0, 6.5, 7, 9);      // bucket 6: the overflow; the rescan at bucket 4 moves it to a list
   EXPECT_EQ(q.top(), 0u);
   EXPECT_EQ(q.time_of(0), 6.5);
+  EXPECT_EQ(q.tag_of(0), 7u);
+  EXPECT_EQ(q.stamp_of(0), 9u);
   Calendar r;  // the same with a second, later slot in the overflow: no jump past the first
   r.reset(2, 1.0, 4, 0.0);
   r.set(0, 6.5);
