@@ -95,6 +95,7 @@
 #include "geometry/distance.hpp"
 #include "geometry/posed.hpp"
 #include "math/brent.hpp"
+#include "math/small_lu.hpp"
 #include "math/types.hpp"
 #include "motion/free_flight.hpp"
 #include "motion/motion.hpp"
@@ -514,7 +515,7 @@ struct Solver {
       Vec5c F;
       Mat5c J;
       contact_system(A, B, y, F, &J);
-      Vec5c dy = J.partialPivLu().solve(-F);
+      Vec5c dy = SmallLU<5>(J).solve(-F);
       if (!dy.allFinite()) break;
       const double dx = dy.head<3>().norm();
       double xi = 1.0;

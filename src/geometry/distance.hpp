@@ -119,6 +119,7 @@
 
 #include "geometry/penetration.hpp"
 #include "geometry/posed.hpp"
+#include "math/small_lu.hpp"
 #include "math/types.hpp"
 #include "shapes/ellipsoid.hpp"
 #include "shapes/shape.hpp"
@@ -449,7 +450,7 @@ bool relaxed_newton(Eigen::Matrix<double, N, 1>& y, System&& system, Measure&& m
       continue;
     }
     backtracks = 0;
-    const Eigen::PartialPivLU<Mat> lu(J);
+    const SmallLU<N> lu(J);  // Eigen's PartialPivLU to the bit, unrolled (math/small_lu.hpp)
     Vec dy = lu.solve(-F);
     bool exact = dy.allFinite();
     StepInfo s = measure(y, dy, at);
