@@ -22,7 +22,8 @@
 // Algorithm: the first root of the six d_f by conservative advancement (contact/first_root.hpp:
 // Lipschitz steps max(d_f, eps) / K_f, a grazing search where a hidden dip is possible, brackets
 // shrunk to a few ulps, the left end kept), so the time returned is never later than the first
-// contact with the shrunken box.
+// contact with the shrunken box. Shapes of bounded curvature also give |d_f''| <= M_f
+// (curvature_bound), and the search then takes second-order steps where they are longer.
 // Growth: with scale s(t) = scale + scale_rate (t - t_state) the body is its shape scaled by s(t)
 // about its centre (Lubachevsky–Stillinger starts against walls, locals/planar_walls.hpp):
 // d_f(t) = c - margin - n.r(t) - s(t) h(R(t)^T n), d_f' gains -s' h and its rotational part the
@@ -144,6 +145,33 @@ struct BoxDistance {
            sdot * shape.support(nb);
   }
   double component_at(int f, double t) const { return face_at(f, t); }
+  // |d_f''| <= M_f, for shapes of bounded curvature (kInf otherwise: Lipschitz steps only).
+  // With m(t) = R(t)^T u (u the face's axis) and h the support function of the shape at scale 1,
+  // d_f = lim_k -+ x_k(t) - s(t) h(+-m(t)) and x_k'' = 0 (free flight), so
+  //     |d_f''| <= 2 |s'| |dh/dt| + s |d^2 h/dt^2|,   |dh/dt| <= L |m'|,
+  //     |d^2 h/dt^2| <= rho |m'|^2 + L |m''|
+  // (rho the largest principal radius of curvature bounds the support Hessian on tangent
+  // vectors, |p| <= L), with |m'| = |w x u| and |m''| = |w| |w x u| for a spherical top (m turns
+  // about a fixed body axis), |m'| <= max |w| and |m''| <= max |w|^2 + max |W'| otherwise: the
+  // bounds of contact/axis_gap.hpp for one body.
+  double curvature_bound(int f) const {
+    if constexpr (requires { shape.max_curvature_radius(); }) {
+      const double rho = shape.max_curvature_radius();
+      if (!std::isfinite(rho) || !std::isfinite(smax)) return kInf;
+      const Vec3 u = axes.col(f >> 1);
+      double sw, mdd;
+      if (motion.spherical()) {
+        sw = st.w.cross(u).norm();
+        mdd = st.w.norm() * sw;
+      } else {
+        sw = motion.max_angular_speed();
+        mdd = sw * sw + motion.max_angular_acceleration();
+      }
+      return 2.0 * std::abs(sdot) * L * sw + smax * (rho * sw * sw + L * mdd);
+    } else {
+      return kInf;
+    }
+  }
   // |d_f'| <= K_f (a top that is not spherical: |w x u| <= max |w(t)|)
   double rate_bound(int f) const {
     const Vec3 u = axes.col(f >> 1);

@@ -31,6 +31,8 @@
 //                                         // every d_f(t), and the rates d_f'(t) when dd != null
 //     double component_at(int f, double t) const;                     // d_f(t) alone
 //     double rate_bound(int f) const;                                 // K_f over the window
+// and optionally
+//     double curvature_bound(int f) const;     // M_f >= |d_f''| over the window (kInf: none)
 // Output: the first time in the window at which some d_f reaches 0 (the left end of a bracket a
 // few ulps wide, so d_f >= 0 there), the component, and a status: found, none (no root in the
 // window) or negative (some d_f < 0 at t_start: time = t_start, the most negative component).
@@ -47,6 +49,13 @@
 //     is unimodal there in all but pathological cases. A dip it misses is at most
 //     (d0 + d1 - K_f dt) / 2 >= -eps / 2 deep (Lipschitz): callers that must never pass a root
 //     search for d_f - eps / 2 (a margin; escape_time.hpp, the walls).
+//  Second order (components with a finite curvature bound M_f, unless
+//  FirstRootOptions::second_order is false: the slow twin): the rates come with every value and
+//  each component's step is the longer of the Lipschitz step and curvature_step(d_f, d_f', M_f),
+//  which is rigorous (no zero before it). Far from a root the Lipschitz step dominates; near an
+//  approaching face the curvature step follows the real rate instead of the worst-case K_f,
+//  which is mostly rotation for long bodies, so the search takes a few steps instead of a
+//  geometric series of them.
 //  4. Every bracket of the step is shrunk on the sign of d_f (Illinois + bisection) to a width
 //     of a few ulps of t and its left end (d_f >= 0) is kept; the earliest component wins. The
 //     time returned is therefore never later than the first root found.
@@ -94,6 +103,7 @@ struct FirstRootOptions {
   long max_steps = 50'000'000;  // guard; exceeding it stops the search (status none, time =
                                 // the last safe time, `truncated` set)
   int brent_max_evals = 60;
+  bool second_order = true;  // use curvature_bound where F has one (false: Lipschitz steps only)
 };
 
 struct FirstRoot {
@@ -113,11 +123,20 @@ FirstRoot first_root(const F& fn, double t_start, double t_max, double eps_in,
                      const std::array<double, F::kComponents>* d_start = nullptr) {
   constexpr int m = F::kComponents;
   FirstRoot out;
-  std::array<double, m> K, d0, d1;
+  std::array<double, m> K, d0, d1, M, dd0{}, dd1{};
+  std::array<double, m> safe{};  // per component: the rigorous curvature step of this step
   double kmax = 0.0;
   for (int f = 0; f < m; ++f) kmax = std::max(kmax, K[f] = fn.rate_bound(f));
+  bool second = false;  // some component takes curvature steps
+  if constexpr (requires { fn.curvature_bound(0); }) {
+    for (int f = 0; f < m; ++f) {
+      M[f] = o.second_order ? fn.curvature_bound(f) : kInf;
+      second = second || std::isfinite(M[f]);
+    }
+  }
   double t = t_start;
-  if (d_start) d0 = *d_start;
+  if (second) fn.at(t, d0, &dd0);  // the same values as d_start, with the rates
+  else if (d_start) d0 = *d_start;
   else fn.at(t, d0, nullptr);
   {
     int fmin = 0;
@@ -142,22 +161,29 @@ FirstRoot first_root(const F& fn, double t_start, double t_max, double eps_in,
       return out;
     }
     double dt = kInf;
-    for (int f = 0; f < m; ++f)
-      if (K[f] > 0.0) dt = std::min(dt, lipschitz_step(d0[f], eps, K[f]));
+    for (int f = 0; f < m; ++f) {
+      if (!(K[f] > 0.0)) continue;
+      double step = lipschitz_step(d0[f], eps, K[f]);
+      if (second && std::isfinite(M[f])) {
+        safe[f] = curvature_step(d0[f], dd0[f], M[f]);
+        step = std::max(step, safe[f]);
+      }
+      dt = std::min(dt, step);
+    }
     const double t1 = std::min(t + dt, t_max);
     const double h = t1 - t;
-    fn.at(t1, d1, nullptr);
+    fn.at(t1, d1, second ? &dd1 : nullptr);
     // brackets [t, hi_f] of this step, per component
     double best_t = kInf;
     int best_f = -1;
     double best_d = 0.0;
-    std::array<double, m> dd0{}, dd1{};
-    bool rates = false;
+    bool rates = second;  // both ends' rates known
     for (int f = 0; f < m; ++f) {
       double hi = kInf, dhi = 0.0;
       if (d1[f] <= 0.0) {  // (a step of exactly d / K can land on the root: d1 = 0)
         hi = t1, dhi = d1[f];
-      } else if (dip_possible(d0[f], d1[f], K[f], h)) {  // grazing search
+      } else if (!(second && h <= safe[f]) &&  // (no dip inside a rigorous curvature step)
+                 dip_possible(d0[f], d1[f], K[f], h)) {  // grazing search
         if (!rates) {
           fn.at(t, d0, &dd0);
           fn.at(t1, d1, &dd1);
@@ -191,6 +217,7 @@ FirstRoot first_root(const F& fn, double t_start, double t_max, double eps_in,
     }
     t = t1;
     d0 = d1;
+    if (second) dd0 = dd1;
   }
   return out;
 }

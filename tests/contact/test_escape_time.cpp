@@ -118,6 +118,67 @@ TEST(EscapeTime, RatesMatchFiniteDifferences) {
   }
 }
 
+// |d_f''| <= M_f (curvature_bound): second differences of d_f along random flights, with the
+// largest ratio printed (a bound that is too tight fails here).
+TEST(EscapeTime, CurvatureBoundHoldsAlongFlights) {
+  testing::Rng r(31);
+  double worst = 0.0;
+  for (int k = 0; k < 400; ++k) {
+    const Ellipsoid e = r.ellipsoid(10.0);
+    BodyState s{r.ball(1.0), r.quat(), 3.0 * r.unit(), r.log_uni(0.1, 30.0) * r.unit()};
+    const Obb box = box_around(e, s, 0.3);
+    const BoxDistance<Ellipsoid> D(e, s, 0.0, box, 0.01);
+    const double h = 1e-4 / (1.0 + s.w.norm());
+    for (int j = 0; j < 20; ++j) {
+      const double t = r.uni(0.0, 2.0);
+      std::array<double, 6> d, dp, dm;
+      D.at(t, d);
+      D.at(t + h, dp);
+      D.at(t - h, dm);
+      for (int f = 0; f < 6; ++f) {
+        const double d2 = (dp[f] - 2.0 * d[f] + dm[f]) / (h * h);
+        worst = std::max(worst, std::abs(d2) / D.curvature_bound(f));
+      }
+    }
+  }
+  std::printf("[ ESCAPE ] max |d''| / M over 48,000 samples: %.3f\n", worst);
+  EXPECT_LE(worst, 1.0 + 1e-3);
+  EXPECT_GT(worst, 0.2);  // and the bound is not absurdly loose
+}
+
+// The second-order steps against the slow twin (Lipschitz steps only): the same status, face
+// and time on random flights (both are bracketed to a few ulps), in fewer steps.
+TEST(EscapeTime, SecondOrderStepsGiveTheSameEscapesInFewerSteps) {
+  testing::Rng r(2718);
+  long steps1 = 0, steps2 = 0, escapes = 0;
+  double worst = 0.0;
+  const int n = hb::testing::scaled_count(4000, 0.05);
+  for (int k = 0; k < n; ++k) {
+    const Ellipsoid e = r.ellipsoid(10.0);
+    BodyState s{r.ball(1.0), r.quat(), r.log_uni(0.01, 10.0) * r.unit(),
+                r.log_uni(0.01, 30.0) * r.unit()};
+    const double shell = r.log_uni(0.01, 0.5) * e.inscribed_radius();
+    const Obb box = box_around(e, s, shell);
+    const double margin = std::min(0.01 * e.inscribed_radius(), 0.25 * shell);
+    const double K = s.v.norm() + s.w.norm() * e.bounding_radius();
+    EscapeInput<Ellipsoid> in{e, s, 0.0, 0.0, 40.0 * (shell + 2.0) / K, box, margin, margin};
+    EscapeOptions slow;
+    slow.second_order = false;
+    const EscapeResult a = escape_time(in, slow), b = escape_time(in);
+    steps1 += a.steps, steps2 += b.steps;
+    ASSERT_EQ(a.status, b.status) << "case " << k;
+    if (a.status != EscapeStatus::escapes) continue;
+    ++escapes;
+    EXPECT_EQ(a.face, b.face) << "case " << k;
+    worst = std::max(worst, std::abs(a.time - b.time) / std::max(1.0, a.time));
+  }
+  std::printf("[ ESCAPE ] %d flights, %ld escapes: steps %ld (Lipschitz) -> %ld (second order), "
+              "largest relative time difference %.1e\n", n, escapes, steps1, steps2, worst);
+  EXPECT_LE(worst, 1e-12);
+  EXPECT_GT(escapes, n / 2);
+  EXPECT_LT(2 * steps2, steps1);  // at least twice fewer steps
+}
+
 TEST(EscapeTime, AlreadyOutsideGivesStartTime) {
   const Ellipsoid e{1.0, 0.5, 0.25};
   BodyState s;
