@@ -6,14 +6,23 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <unistd.h>
 
 #include "io/run.hpp"
 
 namespace hbtest {
 
+// The scratch directory of run `name`: under the temporary directory, named with this process's
+// id, so that two test suites running at the same time (two checkouts on one machine) never
+// write into each other's runs.
+inline std::filesystem::path test_dir(const std::string& name) {
+  return std::filesystem::temp_directory_path() /
+         ("hardbody-test-" + std::to_string(::getpid()) + "-" + name);
+}
+
 inline nlohmann::json run_config(const std::string& name, const std::string& text,
                                  const std::vector<std::string>& overrides = {}) {
-  const auto dir = std::filesystem::temp_directory_path() / ("hardbody-test-" + name);
+  const auto dir = test_dir(name);
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   const auto cfg = dir / (name + ".toml");

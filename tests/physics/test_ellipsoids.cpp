@@ -108,7 +108,7 @@ TEST(EllipsoidPhysics, FreeRotorC2FollowsAnalyticCurve) {
   cfg = cfg.substr(0, cfg.find("[observables]")) +
         "[observables]\ninterval = 0.02\norigin_every = 5\nmax_lag = 1.0\ngr_interval = 0.0\n";
   const auto s = run_config("rotors", cfg);
-  std::ifstream in(std::filesystem::temp_directory_path() / "hardbody-test-rotors" / "out" / "correlations.tsv");
+  std::ifstream in(hbtest::test_dir("rotors") / "out" / "correlations.tsv");
   ASSERT_TRUE(in);
   std::string line;
   int rows = 0;

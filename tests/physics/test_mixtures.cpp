@@ -123,7 +123,7 @@ TEST(MixturePhysics, PolydisperseSpheresMatchGeneralisedBmcsl) {
       "polydispersity = { distribution = \"gaussian\", width = 0.1 }\n"
       "[run]\nequilibrate_time = 20\ntime = 30\n[output]\nlog_interval = 0.5\nsnapshot_interval = 10\n";
   const auto s = run_config("polydisperse", cfg);
-  const auto dir = std::filesystem::temp_directory_path() / "hardbody-test-polydisperse" / "out";
+  const auto dir = hbtest::test_dir("polydisperse") / "out";
   const auto frame = hb::gsd::read_last_frame(dir / "trajectory.gsd");
   const auto& scale = frame.log.at("particles/hardbody/scale").values;
   ASSERT_EQ(scale.size(), 1000u);

@@ -49,7 +49,7 @@ TEST(WallPhysics, HardSpheresInASlitObeyTheContactTheoremAndTheBulkEquationOfSta
   // the middle of the slit: more than 4.5 diameters from both walls (|z| <= 3 for Lz = 15); the
   // layering next to the walls is still ~2 % at 3.5 diameters at phi = 0.35 (measured: the mean
   // over |z| <= 4.5 is 0.2 % low, which moves the Hansen-Goos pressure by 0.6 %)
-  const std::string dir = (std::filesystem::temp_directory_path() / "hardbody-test-slit" / "out").string();
+  const std::string dir = (hbtest::test_dir("slit") / "out").string();
   const double rho_mid = middle_density(dir + "/density_profile.tsv", 0.5 * Lz - 4.5);
   const double phi_mid = M_PI / 6.0 * rho_mid;
   const double p_hg = rho_mid * z_hansen_goos(phi_mid);
