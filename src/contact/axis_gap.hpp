@@ -43,6 +43,20 @@
 
 namespace hb {
 
+// One body's rotation bounds for a fixed lab direction n (see above): |m'| <= sw and
+// |m''| <= mdd for m(t) = R(t)^T n; spherical tops turn m about a fixed body axis.
+struct TurnBounds {
+  double sw, mdd;
+};
+inline TurnBounds turn_bounds(const Motion& mo, const Vec3& n) {
+  if (mo.spherical()) {
+    const double sw = mo.initial().w.cross(n).norm();
+    return {sw, mo.initial().w.norm() * sw};
+  }
+  const double sw = mo.max_angular_speed();
+  return {sw, sw * sw + mo.max_angular_acceleration()};
+}
+
 template <SupportShape SA, SupportShape SB>
 class AxisGap {
  public:
@@ -68,15 +82,13 @@ class AxisGap {
     const BodyState& a = ma.initial();
     const BodyState& b = mb.initial();
     const double La = sa.bounding_radius(), Lb = sb.bounding_radius();
-    const double swa = ma.spherical() ? a.w.cross(n).norm() : ma.max_angular_speed();
-    const double swb = mb.spherical() ? b.w.cross(n).norm() : mb.max_angular_speed();
+    const TurnBounds ta = turn_bounds(ma, n), tb = turn_bounds(mb, n);
+    const double swa = ta.sw, swb = tb.sw;
     wa_ = a.w.norm(), wb_ = b.w.norm();
     ndv_ = std::abs(n.dot(dv_));
     rot_ = La * swa + Lb * swb;
     Lsum_ = La + Lb;
-    // bounds of |m''| per body: |w| |w x n| for a spherical top (m turns about a fixed axis)
-    const double mdd_a = ma.spherical() ? wa_ * swa : swa * swa + ma.max_angular_acceleration();
-    const double mdd_b = mb.spherical() ? wb_ * swb : swb * swb + mb.max_angular_acceleration();
+    const double mdd_a = ta.mdd, mdd_b = tb.mdd;  // bounds of |m''| per body
     if constexpr (kMayCurve)
       if (curved_)
         Mrigid_ = swa * swa * sa.max_curvature_radius() + La * mdd_a +

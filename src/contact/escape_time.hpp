@@ -39,6 +39,7 @@
 #include <array>
 #include <cmath>
 
+#include "contact/axis_gap.hpp"
 #include "contact/first_root.hpp"
 #include "geometry/obb.hpp"
 #include "math/types.hpp"
@@ -158,15 +159,7 @@ struct BoxDistance {
     if constexpr (requires { shape.max_curvature_radius(); }) {
       const double rho = shape.max_curvature_radius();
       if (!std::isfinite(rho) || !std::isfinite(smax)) return kInf;
-      const Vec3 u = axes.col(f >> 1);
-      double sw, mdd;
-      if (motion.spherical()) {
-        sw = st.w.cross(u).norm();
-        mdd = st.w.norm() * sw;
-      } else {
-        sw = motion.max_angular_speed();
-        mdd = sw * sw + motion.max_angular_acceleration();
-      }
+      const auto [sw, mdd] = turn_bounds(motion, Vec3(axes.col(f >> 1)));
       return 2.0 * std::abs(sdot) * L * sw + smax * (rho * sw * sw + L * mdd);
     } else {
       return kInf;
