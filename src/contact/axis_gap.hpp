@@ -34,6 +34,7 @@
 // s_max the largest scale over the interval considered (`bounds(s_max)`).
 #pragma once
 #include <cmath>
+#include <algorithm>
 #include <concepts>
 
 #include "math/types.hpp"
@@ -174,40 +175,81 @@ class AxisGap {
 
 // A separating direction at time t without a distance solve. The gap along n,
 // G(n) = n.c - h_A(R_A^T n) - h_B(-R_B^T n) (c the centre separation), has the gradient
-// x_B - x_A (x_A, x_B the support points of A along n and of B along -n); its maximum over
-// unit n is the distance of separated bodies. Gradient ascent on the sphere,
-// n <- normalise(n + P (x_B - x_A) / beta), P the tangential projection, step scale
-// beta = |c| + (L_A + L_B) / 2 (about the curvature of G on the sphere; the plain fixed point
-// n <- x_B - x_A oscillates), from the line of centres; a step that does not increase the gap
-// is retried at half the length. Returns the best axis, its gap in `gap` (one evaluation per
-// iteration; the search stops early once the gap reaches `enough`); `scale` scales both shapes
-// (growth). Zero vector if the centres coincide.
+// sep = x_B - x_A + c (x_A, x_B the support points of A along n and of B along -n); its maximum
+// over unit n is the distance of separated bodies, and |sep| bounds it from above (the distance
+// of two surface points), so G(n) <= d <= |sep|. G is concave on R^3 (a linear term minus two
+// support functions), and on the unit sphere its Hessian is -(H_A + H_B) - G P, with H the
+// lab-frame support Hessians (the principal radii of curvature at the support points) and P
+// the tangential projection. Newton steps on the sphere, from `start` (or the line of centres):
+//     (H_A + H_B + max(G, l) P) delta = P sep,   n <- normalise(n + delta),
+// delta tangent and at most 1/2 rad, halved until G increases (l: a small length that keeps
+// the system definite where G < 0 or a radius of curvature vanishes). For elongated bodies the
+// radii differ by (a/b)^2 between directions, which is why plain gradient ascent needs many
+// steps there. Stops once the gap reaches `enough`, once |sep| - G <= tol (the axis is within
+// tol of the best one), or after `iterations` evaluations of G (each two support points);
+// returns the best axis and its gap in `gap`; `scale` scales both shapes (growth). Zero vector
+// if the centres coincide.
 template <SupportShape SA, SupportShape SB>
 Vec3 separating_axis(const SA& sa, const Motion& a, const SB& sb, const Motion& b, double tau,
-                     int iterations, double& gap, double enough = kInf, double scale = 1.0) {
+                     int iterations, double& gap, double enough = kInf, double scale = 1.0,
+                     const Vec3* start = nullptr, double tol = 0.0, double rel_tol = 0.0) {
   const Vec3 c = (b.initial().r - a.initial().r) + (b.initial().v - a.initial().v) * tau;
   gap = -kInf;
   if (!(c.squaredNorm() > 0.0)) return Vec3::Zero();
   const Mat3 Ra = a.rotation(tau), Rb = b.rotation(tau);
-  double beta = c.norm() + 0.5 * scale * (sa.bounding_radius() + sb.bounding_radius());
-  auto eval = [&](const Vec3& n, Vec3& sep) {
-    const Vec3 xa = scale * (Ra * sa.support_point(Vec3(Ra.transpose() * n)));
-    const Vec3 xb = scale * (Rb * sb.support_point(Vec3(-(Rb.transpose() * n))));
-    sep = c + xb - xa;
+  const double l = 1e-3 * scale * std::min(sa.inscribed_radius(), sb.inscribed_radius());
+  Vec3 ma, mb;  // body-frame directions of the last accepted evaluation
+  auto eval = [&](const Vec3& n, Vec3& sep, Vec3& ua, Vec3& ub) {
+    ua = Ra.transpose() * n;
+    ub = -(Rb.transpose() * n);
+    sep = c + scale * (Rb * sb.support_point(ub) - Ra * sa.support_point(ua));
     return n.dot(sep);
   };
-  Vec3 best = c.normalized(), sep;
-  gap = eval(best, sep);
-  for (int it = 1; it < iterations && gap < enough; ++it) {
-    const Vec3 n = (best + (sep - gap * best) / beta).normalized();
-    Vec3 s;
-    const double g = eval(n, s);
-    if (g > gap) {
-      best = n, sep = s, gap = g;
-      beta *= 0.8;
-    } else {
-      beta *= 2.0;  // overshoot: a shorter step from the best axis
+  Vec3 best = c.normalized();
+  if (start && start->squaredNorm() > 0.0) best = start->normalized();
+  Vec3 sep;
+  gap = eval(best, sep, ma, mb);
+  int evals = 1;
+  while (evals < iterations && gap < enough && sep.norm() - gap > std::max(tol, rel_tol * gap)) {
+    // tangent basis (e1, e2) at n; the support Hessians in it, each body in its own frame
+    const Vec3 e1 =
+        (std::abs(best.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(best).normalized();
+    const Vec3 e2 = best.cross(e1);
+    const Vec3 a1 = Ra.transpose() * e1, a2 = Ra.transpose() * e2;
+    const Vec3 b1 = Rb.transpose() * e1, b2 = Rb.transpose() * e2;
+    const Mat3 Ha = sa.support_hessian(ma), Hb = sb.support_hessian(mb);
+    const Vec3 Ha1 = Ha * a1, Hb1 = Hb * b1;
+    const double shift = std::max(gap, l);
+    const double m11 = scale * (a1.dot(Ha1) + b1.dot(Hb1)) + shift;
+    const double m12 = scale * (a2.dot(Ha1) + b2.dot(Hb1));
+    const double m22 = scale * (a2.dot(Ha * a2) + b2.dot(Hb * b2)) + shift;
+    const double g1 = e1.dot(sep), g2 = e2.dot(sep);  // tangential gradient
+    const double det = m11 * m22 - m12 * m12;
+    double d1, d2;
+    if (det > 0.0 && m11 > 0.0) {
+      d1 = (m22 * g1 - m12 * g2) / det;
+      d2 = (m11 * g2 - m12 * g1) / det;
+    } else {  // not definite (rounding): a gradient step
+      const double k = 1.0 / (shift + scale * (sa.bounding_radius() + sb.bounding_radius()));
+      d1 = k * g1, d2 = k * g2;
     }
+    Vec3 delta = d1 * e1 + d2 * e2;
+    if (delta.norm() > 0.5) delta *= 0.5 / delta.norm();
+    bool moved = false;
+    while (evals < iterations) {
+      const Vec3 n = (best + delta).normalized();
+      Vec3 s, ua, ub;
+      const double g = eval(n, s, ua, ub);
+      ++evals;
+      if (g > gap) {
+        best = n, sep = s, gap = g, ma = ua, mb = ub;
+        moved = true;
+        break;
+      }
+      delta *= 0.5;
+      if (delta.norm() <= 1e-14) break;
+    }
+    if (!moved) break;  // no increase along the Newton direction: G is at its maximum to rounding
   }
   return best;
 }

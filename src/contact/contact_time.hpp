@@ -52,11 +52,13 @@
 //  |g_n'| <= K_n <= K and, for shapes with bounded curvature, |g_n''| <= M.  It is advanced by
 //  conservative steps, the larger of g / K_n and the positive root of g + g' dt - M dt^2 / 2
 //  (lipschitz_step and curvature_step of contact/first_root.hpp):
-//   a. before the first distance solve, along an axis found by a few gradient-ascent steps of
-//      the gap over directions (`separating_axis`), re-aimed where the gap runs low; a pair
-//      that cannot meet inside the window usually costs no distance solve at all, and the
-//      first solve starts from the support points of the last axis (a guess, slid together
-//      by a short steepest descent before the NR: DistanceWarmStart::guess);
+//   a. before the first distance solve, along an axis found by Newton steps on the gap over
+//      directions (`separating_axis`: from the line of centres, until the gap rules the
+//      window out or is within axis_rel_tol of the distance), re-aimed from the last axis
+//      where the gap runs low; a pair that cannot meet inside the window costs no distance
+//      solve, and a pair that meets reaches its first solve within ~eps_d of contact, which
+//      starts from the support points of the last axis (a guess, slid together by a short
+//      steepest descent before the NR: DistanceWarmStart::guess);
 //   b. after every distance sample with d >= eps_d, or with d' > 0 for curved shapes (a pair
 //      that just collided and separates), along its normal (there g_n = d, g_n' = d').
 //  Each step leaves g > 0, hence d > 0, behind it, so no contact is skipped; near contact
@@ -154,6 +156,10 @@ struct ContactOptions {
   int brent_max_evals = 60;
   double accept_tol = 1e-10;    // NR contact accepted if |d(t_c)| <= accept_tol * L
   bool separating_axis = true;  // separating-axis advancement (false: the paper's stepping only)
+  // The axis search before the first distance solve (step a of the header): at most this many
+  // gap evaluations per search, stopped once the gap is within axis_rel_tol of the distance.
+  int axis_evals = 12;
+  double axis_rel_tol = 0.3;
   DistanceOptions distance{};
 };
 
@@ -581,13 +587,16 @@ struct Solver {
       // Before any distance solve: advance along the line of centres (a pair that cannot
       // meet inside the window usually costs no distance solve at all).
       // Re-aim the axis where the gap ran low, as long as that makes progress.
+      Vec3 axis = Vec3::Zero();
       for (int k = 0; k < 8 && o.separating_axis; ++k) {
         // a gap of K (hi - lo) already rules out any contact in the window
         const double reach = hi < kInf ? (grow ? rate_bound(lo, hi) : K) * (hi - lo) : kInf;
         double g0;
-        const Vec3 n = separating_axis(in.shape_a, A.motion, in.shape_b, B.motion, lo - in.t_state, 3, g0,
-                                       reach, grow ? A.scale_at(lo) : 1.0);
+        const Vec3 n = separating_axis(in.shape_a, A.motion, in.shape_b, B.motion, lo - in.t_state,
+                                       o.axis_evals, g0, reach, grow ? A.scale_at(lo) : 1.0,
+                                       k > 0 ? &axis : nullptr, 1e-3 * in.eps_d, o.axis_rel_tol);
         if (!(n.squaredNorm() > 0.0)) break;
+        axis = n;
         if (g0 >= reach) return;  // none
         const double t = advance_on_axis(n, lo, hi);
         if (!(t < hi)) return;  // none
