@@ -173,6 +173,22 @@ class AxisGap {
   Vec3 Wa_, Wb_, ka_, kb_;
 };
 
+// The support Hessian H(m) of a shape in the two tangent directions u, v: (u^T H u, u^T H v,
+// v^T H v), given the support point p = support_point(m). Shapes with a closed form provide
+// support_hessian_forms (ellipsoids and spheres: from p, without forming H); any other shape
+// goes through support_hessian, the twin the shape tests compare with.
+template <SupportShape S>
+Vec3 support_hessian_forms(const S& s, const Vec3& m, const Vec3& p, const Vec3& u,
+                           const Vec3& v) {
+  if constexpr (requires { { s.support_hessian_forms(m, p, u, v) } -> std::convertible_to<Vec3>; }) {
+    return s.support_hessian_forms(m, p, u, v);
+  } else {
+    const Mat3 H = s.support_hessian(m);
+    const Vec3 Hu = H * u;
+    return Vec3(u.dot(Hu), v.dot(Hu), v.dot(H * v));
+  }
+}
+
 // A separating direction at time t without a distance solve. The gap along n,
 // G(n) = n.c - h_A(R_A^T n) - h_B(-R_B^T n) (c the centre separation), has the gradient
 // sep = x_B - x_A + c (x_A, x_B the support points of A along n and of B along -n); its maximum
@@ -198,17 +214,20 @@ Vec3 separating_axis(const SA& sa, const Motion& a, const SB& sb, const Motion& 
   if (!(c.squaredNorm() > 0.0)) return Vec3::Zero();
   const Mat3 Ra = a.rotation(tau), Rb = b.rotation(tau);
   const double l = 1e-3 * scale * std::min(sa.inscribed_radius(), sb.inscribed_radius());
-  Vec3 ma, mb;  // body-frame directions of the last accepted evaluation
-  auto eval = [&](const Vec3& n, Vec3& sep, Vec3& ua, Vec3& ub) {
+  // body-frame directions and support points of the last accepted evaluation
+  Vec3 ma, mb, pa, pb;
+  auto eval = [&](const Vec3& n, Vec3& sep, Vec3& ua, Vec3& ub, Vec3& qa, Vec3& qb) {
     ua = Ra.transpose() * n;
     ub = -(Rb.transpose() * n);
-    sep = c + scale * (Rb * sb.support_point(ub) - Ra * sa.support_point(ua));
+    qa = sa.support_point(ua);
+    qb = sb.support_point(ub);
+    sep = c + scale * (Rb * qb - Ra * qa);
     return n.dot(sep);
   };
   Vec3 best = c.normalized();
   if (start && start->squaredNorm() > 0.0) best = start->normalized();
   Vec3 sep;
-  gap = eval(best, sep, ma, mb);
+  gap = eval(best, sep, ma, mb, pa, pb);
   int evals = 1;
   while (evals < iterations && gap < enough && sep.norm() - gap > std::max(tol, rel_tol * gap)) {
     // tangent basis (e1, e2) at n; the support Hessians in it, each body in its own frame
@@ -217,12 +236,12 @@ Vec3 separating_axis(const SA& sa, const Motion& a, const SB& sb, const Motion& 
     const Vec3 e2 = best.cross(e1);
     const Vec3 a1 = Ra.transpose() * e1, a2 = Ra.transpose() * e2;
     const Vec3 b1 = Rb.transpose() * e1, b2 = Rb.transpose() * e2;
-    const Mat3 Ha = sa.support_hessian(ma), Hb = sb.support_hessian(mb);
-    const Vec3 Ha1 = Ha * a1, Hb1 = Hb * b1;
+    const Vec3 fa = support_hessian_forms(sa, ma, pa, a1, a2);
+    const Vec3 fb = support_hessian_forms(sb, mb, pb, b1, b2);
     const double shift = std::max(gap, l);
-    const double m11 = scale * (a1.dot(Ha1) + b1.dot(Hb1)) + shift;
-    const double m12 = scale * (a2.dot(Ha1) + b2.dot(Hb1));
-    const double m22 = scale * (a2.dot(Ha * a2) + b2.dot(Hb * b2)) + shift;
+    const double m11 = scale * (fa[0] + fb[0]) + shift;
+    const double m12 = scale * (fa[1] + fb[1]);
+    const double m22 = scale * (fa[2] + fb[2]) + shift;
     const double g1 = e1.dot(sep), g2 = e2.dot(sep);  // tangential gradient
     const double det = m11 * m22 - m12 * m12;
     double d1, d2;
@@ -238,11 +257,11 @@ Vec3 separating_axis(const SA& sa, const Motion& a, const SB& sb, const Motion& 
     bool moved = false;
     while (evals < iterations) {
       const Vec3 n = (best + delta).normalized();
-      Vec3 s, ua, ub;
-      const double g = eval(n, s, ua, ub);
+      Vec3 s, ua, ub, qa, qb;
+      const double g = eval(n, s, ua, ub, qa, qb);
       ++evals;
       if (g > gap) {
-        best = n, sep = s, gap = g, ma = ua, mb = ub;
+        best = n, sep = s, gap = g, ma = ua, mb = ub, pa = qa, pb = qb;
         moved = true;
         break;
       }

@@ -51,6 +51,13 @@ struct Ellipsoid {
     const Vec3 mn = n.cwiseProduct(sq());
     return (Mat3(sq().asDiagonal()) - mn * mn.transpose() / (h * h)) / h;
   }
+  // (u^T H u, u^T H v, v^T H v) for H = support_hessian(n) = (M - p p^T) / h, given the support
+  // point p = M n / h (h = p.n): no matrix formed (contact/axis_gap.hpp).
+  Vec3 support_hessian_forms(const Vec3& n, const Vec3& p, const Vec3& u, const Vec3& v) const {
+    const double h = p.dot(n), pu = p.dot(u), pv = p.dot(v);
+    const Vec3 Mu = u.cwiseProduct(sq());
+    return Vec3(u.dot(Mu) - pu * pu, v.dot(Mu) - pu * pv, v.dot(v.cwiseProduct(sq())) - pv * pv) / h;
+  }
 };
 
 struct Sphere {
@@ -75,6 +82,11 @@ struct Sphere {
   Mat3 support_hessian(const Vec3& n) const {
     const double nn = n.norm();
     return (radius / nn) * (Mat3::Identity() - n * n.transpose() / (nn * nn));
+  }
+  // (u^T H u, u^T H v, v^T H v) for H = support_hessian(n) (p unused: it is r n / |n|).
+  Vec3 support_hessian_forms(const Vec3& n, const Vec3& /*p*/, const Vec3& u, const Vec3& v) const {
+    const double nn2 = n.squaredNorm(), k = radius / std::sqrt(nn2), nu = n.dot(u), nv = n.dot(v);
+    return k * Vec3(u.dot(u) - nu * nu / nn2, u.dot(v) - nu * nv / nn2, v.dot(v) - nv * nv / nn2);
   }
 };
 

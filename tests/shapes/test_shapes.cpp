@@ -1,5 +1,6 @@
 // Shape concept: f, gradient, Hessian against finite differences; volume; ray intersection;
-// support function against its definition.
+// support function against its definition; the support Hessian by finite differences and its
+// closed-form quadratic forms against it.
 #include <gtest/gtest.h>
 
 #include <random>
@@ -62,6 +63,14 @@ void check_support(const S& s, int samples) {
       hfd.col(i) = (s.support_point(n + e) - s.support_point(n - e)) / (2 * h);
     }
     EXPECT_LE((hfd - s.support_hessian(n)).norm(), 1e-6 * s.support_hessian(n).norm() + 1e-9);
+    // the closed-form quadratic forms (the separating-axis Newton) against support_hessian
+    const Vec3 u = rand_vec(1.0), v = rand_vec(1.0);
+    const Mat3 H = s.support_hessian(n);
+    const Vec3 f = s.support_hessian_forms(n, p, u, v);
+    const double scale = H.norm() * u.norm() * v.norm();
+    EXPECT_NEAR(f[0], u.dot(H * u), 1e-13 * scale);
+    EXPECT_NEAR(f[1], u.dot(H * v), 1e-13 * scale);
+    EXPECT_NEAR(f[2], v.dot(H * v), 1e-13 * scale);
   }
 }
 
