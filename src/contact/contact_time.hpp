@@ -501,19 +501,13 @@ struct Solver {
   }
 
   // Contact NR from the bracket [lo, hi] (d(lo) > 0 > d(hi)); fallback: shrink the bracket.
-  void solve_bracket(const Sample& lo, const Sample& hi) {
-    const double t0 = lo.t + (hi.t - lo.t) * lo.d / (lo.d - hi.d);
-    const Sample g = eval(t0);
-    if (failed) return;
-    if (g.d == 0.0) {
-      report_hit(g.t, 0.5 * (g.res.point_a + g.res.point_b), g.res.normal);
-      return;
-    }
-    // the smaller sub-bracket around the secant point
-    const Sample& l = g.d > 0 ? g : lo;
-    const Sample& h = g.d > 0 ? hi : g;
+  // The NR starts at the secant time with the closest points and multiplier of the end nearer
+  // to contact (no distance solve: the bracket is at most one rate step eps_d / K wide).
+  void solve_bracket(const Sample& l, const Sample& h) {
+    const double t0 = l.t + (h.t - l.t) * l.d / (l.d - h.d);
+    const Sample& g = l.d <= -h.d ? l : h;
     Vec5c y;
-    y << 0.5 * (g.res.point_a + g.res.point_b), std::max(g.res.alpha, 1e-3), g.t;
+    y << 0.5 * (g.res.point_a + g.res.point_b), std::max(g.res.alpha, 1e-3), t0;
     const double dt_tol = 1e-12 * L / std::max(K, 1e-300);
     bool ok = false;
     for (int it = 0; it < o.max_nr_iter; ++it) {
