@@ -14,6 +14,7 @@ says with which source commit and on which date they were measured (the rows' "s
 import csv
 import json
 import math
+import statistics
 import os
 import sys
 
@@ -604,12 +605,28 @@ def study_e(rep):
     # e2
     e2 = rep.ok("e2")
     if e2:
-        t = {r["X0"]: r["tau_c_us"] for r in e2}
+        by_x0 = {}
+        for r in e2:
+            by_x0.setdefault(r["X0"], []).append(r["tau_c_us"])
+        t = {k: statistics.median(v) for k, v in by_x0.items()}  # median of the rounds
+        rounds = max(len(v) for v in by_x0.values())
         spread = max(t.values()) / min(t.values())
-        rep.targets.append(("tau_c(NNL) max/min over X0 = 1, 2, 5, 10 at phi = 0.4",
+        # the issue's form: the longest and the flattest body against X0 = 1 (if measured),
+        # else the spread over all X0
+        ends = [k for k in (0.1, 10.0) if k in t] if 1.0 in t else []
+        worst = max(t[k] / t[1.0] for k in ends) if ends else spread
+        rep.targets.append(("tau_c(NNL, X0) / tau_c(NNL, X0 = 1) at X0 = "
+                            + " and ".join(f"{k:g}" for k in ends) + ", phi = 0.4"
+                            if ends else "tau_c(NNL) max/min over X0 at phi = 0.4",
                             "\"quite X0-independent\" up to X0 = 10",
-                            f"{spread:.2f} (" + ", ".join(f"X0={k:g}: {v:.0f} us" for k, v in sorted(t.items())) +
-                            f"; N = {e2[0]['N']})", f"<= {X0_SPREAD_TARGET:g}", spread <= X0_SPREAD_TARGET,
+                            ", ".join(f"X0={k:g}: {t[k] / t[1.0]:.2f}" for k in ends) +
+                            (f"; max/min over all X0 {spread:.2f}" if ends else f"{spread:.2f}") + " (" +
+                            ", ".join(f"X0={k:g}: {v:.0f} us" for k, v in sorted(t.items())) +
+                            f"; N = {e2[0]['N']}" +
+                            (f"; medians of {rounds} alternating rounds, per round " +
+                             "; ".join(f"X0={k:g}: " + ", ".join(f"{x:.0f}" for x in by_x0[k])
+                                       for k in sorted(by_x0)) if rounds > 1 else "") + ")",
+                            f"<= {X0_SPREAD_TARGET:g}", worst <= X0_SPREAD_TARGET,
                             rep.measured_by(e2)))
     # e3
     e3 = rep.ok("e3") or rep.study("e3")
