@@ -201,8 +201,10 @@ Vec3 support_hessian_forms(const S& s, const Vec3& m, const Vec3& p, const Vec3&
 // delta tangent and at most 1/2 rad, halved until G increases (l: a small length that keeps
 // the system definite where G < 0 or a radius of curvature vanishes). For elongated bodies the
 // radii differ by (a/b)^2 between directions, which is why plain gradient ascent needs many
-// steps there. Stops once the gap reaches `enough`, once |sep| - G <= tol (the axis is within
-// tol of the best one), or after `iterations` evaluations of G (each two support points);
+// steps there. Stops once the gap reaches `enough`, once |sep| - G <= max(tol, rel_tol G) (the
+// gap is within that of the distance), or after `iterations` evaluations of G (each two support
+// points). The same Newton step, in the relative frame and run to convergence, is the distance
+// solver's support stage (geometry/distance.hpp, support_maximum);
 // returns the best axis and its gap in `gap`; `scale` scales both shapes (growth). Zero vector
 // if the centres coincide.
 template <SupportShape SA, SupportShape SB>

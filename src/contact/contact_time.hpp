@@ -578,9 +578,9 @@ struct Solver {
       return;
     }
     if constexpr (kAxis) {
-      // Before any distance solve: advance along the line of centres (a pair that cannot
-      // meet inside the window usually costs no distance solve at all).
-      // Re-aim the axis where the gap ran low, as long as that makes progress.
+      // Before any distance solve: advance along the best axis found from the line of centres
+      // (a pair that cannot meet inside the window costs no distance solve at all).
+      // Re-aim the axis, from the last one, where the gap ran low, as long as that makes progress.
       Vec3 axis = Vec3::Zero();
       for (int k = 0; k < 8 && o.separating_axis; ++k) {
         // a gap of K (hi - lo) already rules out any contact in the window
