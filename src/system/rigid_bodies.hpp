@@ -13,10 +13,8 @@
 #include <cstdint>
 #include <sstream>
 #include <stdexcept>
-#include <vector>
 
 #include "collision/rigid.hpp"
-#include "contact/contact_bound.hpp"
 #include "contact/contact_time.hpp"
 #include "geometry/distance.hpp"
 #include "motion/growth_law.hpp"
@@ -114,79 +112,32 @@ CollisionContact collision_contact(const BodyState& a, const BodyState& b, const
   return c;
 }
 
-// Scratch of the prediction loop (owned by the model; the loop is not re-entrant).
-struct PredictScratch {
-  struct Candidate {
-    double bound;     // lower bound of the contact time (absolute)
-    std::uint32_t k;  // index into the candidate arrays
-  };
-  std::vector<Candidate> order;
-  std::vector<BodyState> b;   // candidate k at `now`, at its image
-  std::vector<double> horizon;
-};
-
 // The prediction loop of the rigid pair models (RigidBodies, RigidMixture): body i (at `now`)
 // against the candidates js (at their images `shifts`, or the minimum image), each window cut at
-// the candidate's horizon and at law_end (where the growth law changes). solve(a, b, j, horizon)
-// runs the pair's contact-time solver; a failed solve throws SolverFailure(fail(a, b, j, horizon)).
-// With `trim`, only the earliest contact matters: bound(a, b, j) gives a lower bound of the
-// pair's contact time (contact/contact_bound.hpp; `now` when it knows none), the candidates are
-// solved in increasing order of it, each window also ends at the earliest contact found so far,
-// and the candidates whose bound lies beyond their window are not solved at all (out = inf, as
-// a solve would give). Solving the likeliest partners first shortens every later window, and a
-// shorter window is ruled out by a shorter separating-axis search. Without `trim` every
-// candidate is solved in the given order up to law_end (the slow twin the tests compare with).
-template <class Solve, class Fail, class Bound>
+// the candidate's horizon, at law_end (where the growth law changes) and, with `trim`, at the
+// earliest contact found so far (later ones are not needed). solve(a, b, j, horizon) runs the
+// pair's contact-time solver; a failed solve throws SolverFailure(fail(a, b, j, horizon)).
+template <class Solve, class Fail>
 void predict_contacts(const State& s, const Box& box, std::uint32_t i, const std::uint32_t* js,
                       const Vec3* shifts, std::size_t n, double now, const double* horizons,
-                      double* out, double law_end, bool trim, SolverStats& stats,
-                      PredictScratch& scratch, Solve&& solve, Fail&& fail, Bound&& bound) {
+                      double* out, double law_end, bool trim, SolverStats& stats, Solve&& solve,
+                      Fail&& fail) {
   const BodyState a = s.body(i);  // body i is at `now`
-  auto partner = [&](std::size_t k) {
-    BodyState b = s.body_at(js[k], now);
+  double earliest = kInf;
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::uint32_t j = js[k];
+    out[k] = kInf;
+    const double horizon = trim ? std::min({horizons ? horizons[k] : kInf, law_end, earliest}) : law_end;
+    if (j == i || !(horizon > now)) continue;
+    BodyState b = s.body_at(j, now);
     b.r = shifts ? Vec3(b.r + shifts[k]) : Vec3(a.r + box.near_image(b.r - a.r));
-    return b;
-  };
-  auto run = [&](const BodyState& b, std::uint32_t j, double horizon, std::size_t k) {
     const ContactResult r = solve(a, b, j, horizon);
     stats.add(r);
     if (r.status == ContactStatus::failed) throw SolverFailure(fail(a, b, j, horizon));
-    if (r.status == ContactStatus::hit) out[k] = std::max(0.0, r.time - now);
-    return r;
-  };
-  if (!trim) {
-    for (std::size_t k = 0; k < n; ++k) {
-      out[k] = kInf;
-      if (js[k] == i || !(law_end > now)) continue;
-      run(partner(k), js[k], law_end, k);
+    if (r.status == ContactStatus::hit) {
+      out[k] = std::max(0.0, r.time - now);
+      earliest = std::min(earliest, r.time);
     }
-    return;
-  }
-  auto& order = scratch.order;
-  order.clear();
-  if (scratch.b.size() < n) scratch.b.resize(2 * n), scratch.horizon.resize(2 * n);
-  for (std::size_t k = 0; k < n; ++k) {
-    out[k] = kInf;
-    const std::uint32_t j = js[k];
-    const double horizon = std::min(horizons ? horizons[k] : kInf, law_end);
-    if (j == i || !(horizon > now)) continue;
-    BodyState& b = scratch.b[k];
-    b = partner(k);
-    const double lb = bound(a, b, j);
-    if (lb > horizon) continue;  // no contact inside the window
-    scratch.horizon[k] = horizon;
-    order.push_back({lb, static_cast<std::uint32_t>(k)});
-  }
-  std::sort(order.begin(), order.end(), [](const auto& x, const auto& y) {
-    return x.bound < y.bound || (x.bound == y.bound && x.k < y.k);
-  });
-  double earliest = kInf;
-  for (const auto& c : order) {
-    if (c.bound > earliest) break;  // neither this candidate nor any later one comes first
-    const double horizon = std::min(scratch.horizon[c.k], earliest);
-    if (!(horizon > now)) continue;
-    const ContactResult r = run(scratch.b[c.k], js[c.k], horizon, c.k);
-    if (r.status == ContactStatus::hit) earliest = std::min(earliest, r.time);
   }
 }
 
@@ -246,12 +197,10 @@ struct RigidBodies {
   double eps_d = 1e-5;
   ContactOptions options{};
   mutable SolverStats stats{};
-  // Use the loop's per-pair horizons, solve the candidates in the order of their contact-time
-  // bound and stop at the earliest contact found (predict_contacts; false: every
+  // Use the loop's per-pair horizons and stop at the earliest contact found (false: every
   // candidate is solved without any horizon; the slow twin the tests compare against).
   bool trim_horizons = true;
   GrowthLaw law{};  // default: no growth
-  mutable PredictScratch scratch_{};
 
   // Largest centre distance at contact over the run (the final size when growing).
   double interaction_range() const {
@@ -266,7 +215,7 @@ struct RigidBodies {
     const ScaleLaw sl{law.scale_at(now), law.rate_at(now)};        // {1, 0} without growth
     const double law_end = now < law.t_stop ? law.t_stop : kInf;  // the law changes there
     predict_contacts(
-        s, box, i, js, shifts, n, now, horizons, out, law_end, trim_horizons, stats, scratch_,
+        s, box, i, js, shifts, n, now, horizons, out, law_end, trim_horizons, stats,
         [&](const BodyState& a, const BodyState& b, std::uint32_t, double horizon) {
           ContactInput<S, S> in{shape, shape, a, b, now, now, horizon, eps_d};
           in.growth = sl;
@@ -278,11 +227,6 @@ struct RigidBodies {
               i, j, now,
               law.growing() ? fmt::format(" (growth scale {:.17g}, rate {:.17g})", sl.s, sl.rate) : "",
               law.growing() ? " at scale 1" : "", reproducer(a, b, horizon - now));
-        },
-        [&](const BodyState& a, const BodyState& b, std::uint32_t) {
-          if constexpr (SupportShape<S>)  // while the shapes grow: no bound (the given order)
-            if (sl.rate == 0.0) return contact_time_lower_bound(shape, a, shape, b, now, sl.s);
-          return now;
         });
   }
 

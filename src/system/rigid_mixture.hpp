@@ -50,7 +50,6 @@ struct RigidMixture {
   GrowthLaw law{};                     // default: no growth
   mutable SolverStats stats{};
   bool trim_horizons = true;           // as RigidBodies::trim_horizons
-  mutable PredictScratch scratch_{};
 
   static RigidMixture of(const SpeciesTable& species, double eps_d, GrowthLaw law = {}) {
     RigidMixture m;
@@ -95,7 +94,7 @@ struct RigidMixture {
     const ScaleLaw sl{law.scale_at(now), law.rate_at(now)};
     const double law_end = now < law.t_stop ? law.t_stop : kInf;  // the law changes there
     predict_contacts(
-        s, box, i, js, shifts, n, now, horizons, out, law_end, trim_horizons, stats, scratch_,
+        s, box, i, js, shifts, n, now, horizons, out, law_end, trim_horizons, stats,
         [&](const BodyState& a, const BodyState& b, std::uint32_t j, double horizon) {
           return std::visit(
               [&](const auto& A, const auto& B) {
@@ -112,19 +111,6 @@ struct RigidMixture {
               "contact-time solver failed for bodies {} and {} at t = {:.17g} (growth scale "
               "{:.17g}, rate {:.17g}); reproducer: {}",
               i, j, now, sl.s, sl.rate, reproducer(sa, a, body_shape(s, j), b, horizon - now));
-        },
-        [&](const BodyState& a, const BodyState& b, std::uint32_t j) {
-          if (sl.rate != 0.0) return now;  // while the shapes grow: no bound (the given order)
-          return std::visit(
-              [&](const auto& A, const auto& B) {
-                using SA = std::decay_t<decltype(A)>;
-                using SB = std::decay_t<decltype(B)>;
-                if constexpr (SupportShape<SA> && SupportShape<SB>)
-                  return contact_time_lower_bound(A, a, B, b, now, sl.s);
-                else
-                  return now;
-              },
-              sa, body_shape(s, j));
         });
   }
 
