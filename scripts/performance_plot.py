@@ -239,7 +239,11 @@ def header(rep):
           "* Ellipsoids of revolution about body x, semi-axes (X0 b, b, b) with b = 1/2: the paper's "
           "X0 = a/b and phi = pi X0 b^3 rho / 6 with b the full minor length (ERRATA 8), so lengths are in "
           "units of the equatorial diameter, the NNL shell too (Delta_NNL = 0.15 as in the paper). "
-          "Spherical tops with I = 2/5 m r^2, r the smallest semi-axis; kT = m = 1; eps_d = 1e-5 unless varied.",
+          "Spherical tops with I = 2/5 m r^2, r the smallest semi-axis; kT = m = 1; eps_d = 1e-5 unless varied. "
+          "Exception, the elongation study e2: the smallest semi-axis is 1/2 at every X0 (oblate bodies: "
+          "b = 1/(2 X0)), the paper's own unit (\"the length of the smallest semi-axis is chosen as unit of "
+          "distance\"), so the shell and eps_d are the same fraction of every body's thickness; with b = 1/2 "
+          "a X0 = 0.1 disk would be 0.1 thick inside a 0.15 shell.",
           "* Start: the aligned stretched FCC lattice (`src/setup/rigid_setup.hpp`) melted by the warm-up. "
           "The paper started from grown, equilibrated isotropic liquids. The final nematic order S2 of each run "
           "is in the CSV. Values near 0.1 or below mean isotropic at N = 256; values near 1 mean the run stayed "
@@ -615,8 +619,10 @@ def study_e(rep):
         # else the spread over all X0
         ends = [k for k in (0.1, 10.0) if k in t] if 1.0 in t else []
         worst = max(t[k] / t[1.0] for k in ends) if ends else spread
+        # lengths in units of the smallest semi-axis (0.5 at every X0: scripts/performance.py e2_b)
         rep.targets.append(("tau_c(NNL, X0) / tau_c(NNL, X0 = 1) at X0 = "
                             + " and ".join(f"{k:g}" for k in ends) + ", phi = 0.4"
+                            + ", smallest semi-axis 0.5 at every X0"
                             if ends else "tau_c(NNL) max/min over X0 at phi = 0.4",
                             "\"quite X0-independent\" up to X0 = 10",
                             ", ".join(f"X0={k:g}: {t[k] / t[1.0]:.2f}" for k in ends) +
