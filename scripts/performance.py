@@ -75,14 +75,9 @@ ELL = dict(shape="ellipsoid", b=0.5, eps_d="1e-5", shell=0.15, split=1)
 SQ = dict(shape="superquadric", N=512, phi=0.256, inertia=1, eps_d="1e-5", shell=0.15, split=1)
 
 
-def sq_b(x0):
-    """Equatorial semi-axis b with the smallest semi-axis 0.8 (a = X0 b)."""
-    return 0.8 / min(x0, 1.0)
-
-
-def e2_b(x0):
-    """Equatorial semi-axis b with the smallest semi-axis 0.5 (a = X0 b), as sq_b."""
-    return 0.5 / min(x0, 1.0)
+def equatorial_b(x0, smallest):
+    """Equatorial semi-axis b of a body of elongation X0 = a / b whose smallest semi-axis is `smallest`."""
+    return smallest / min(x0, 1.0)
 
 
 def matches(study, prefixes):
@@ -179,7 +174,7 @@ def plan(run, c):
     n_common = None
     for _ in range(c["e2_rounds"]):
         for x0 in sorted(c["e2_x0"], reverse=True):
-            rows = run("bench_rigid", "e2", **dict(ELL, b=e2_b(x0)), N=n_common or 256, phi=0.4,
+            rows = run("bench_rigid", "e2", **dict(ELL, b=equatorial_b(x0, 0.5)), N=n_common or 256, phi=0.4,
                        X0=x0, auto_n=1,
                        warmup=5000, warmup_per_particle=c["e2_warm_pp"], collisions=c["e2_coll"])
             n_common = n_common or (rows[0]["N"] if rows else None)
@@ -193,14 +188,14 @@ def plan(run, c):
     # (f) superquadrics
     for x0 in c["f_x0"]:
         for p in c["f_p"]:
-            run("bench_rigid", "f", **SQ, X0=x0, b=sq_b(x0), p=p, warmup=c["f_warm"],
+            run("bench_rigid", "f", **SQ, X0=x0, b=equatorial_b(x0, 0.8), p=p, warmup=c["f_warm"],
                 collisions=c["f_coll"], budget=c["f_budget"], scan=methods)
     for x0 in c["f_x0"]:
         for p in c["f_long_p"]:
             # another seed than (f): an independent trajectory
-            run("bench_rigid", "f_long", **SQ, X0=x0, b=sq_b(x0), p=p, seed=2, warmup=c["f_warm"],
+            run("bench_rigid", "f_long", **SQ, X0=x0, b=equatorial_b(x0, 0.8), p=p, seed=2, warmup=c["f_warm"],
                 collisions=c["f_long_coll"], method="nnl")
-    run("bench_ratio", "f_ratio", pair="superquadric", N=512, phi=0.256, X0=2, b=sq_b(2.0),
+    run("bench_ratio", "f_ratio", pair="superquadric", N=512, phi=0.256, X0=2, b=equatorial_b(2.0, 0.8),
         inertia=1, eps_d="1e-5", shell=0.15, collisions=c["f_ratio_coll"], warmup=c["f_ratio_warm"],
         rounds=10)
 
@@ -238,7 +233,7 @@ def profile(run, c, out):
         ("ellipsoid X0 = 10, phi = 0.4, NNL",
          dict(ELL, N=256, phi=0.4, X0=10, auto_n=1, warmup=5000, collisions=c["e2_coll"], split=0)),
         ("superquadric X0 = 2, p = 8, NNL",
-         dict(SQ, X0=2, b=sq_b(2.0), p=8, warmup=c["f_warm"], collisions=c["f_coll"], split=0)),
+         dict(SQ, X0=2, b=equatorial_b(2.0, 0.8), p=8, warmup=c["f_warm"], collisions=c["f_coll"], split=0)),
     ]
     rows = []
     with tempfile.TemporaryDirectory() as tmp:

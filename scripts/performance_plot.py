@@ -619,7 +619,7 @@ def study_e(rep):
         # else the spread over all X0
         ends = [k for k in (0.1, 10.0) if k in t] if 1.0 in t else []
         worst = max(t[k] / t[1.0] for k in ends) if ends else spread
-        # lengths in units of the smallest semi-axis (0.5 at every X0: scripts/performance.py e2_b)
+        # lengths in units of the smallest semi-axis (0.5 at every X0: scripts/performance.py, equatorial_b)
         rep.targets.append(("tau_c(NNL, X0) / tau_c(NNL, X0 = 1) at X0 = "
                             + " and ".join(f"{k:g}" for k in ends) + ", phi = 0.4"
                             + ", smallest semi-axis 0.5 at every X0"
