@@ -37,6 +37,7 @@
 #include <algorithm>
 #include <concepts>
 
+#include "geometry/segment.hpp"
 #include "math/types.hpp"
 #include "motion/free_flight.hpp"
 #include "motion/motion.hpp"
@@ -196,49 +197,71 @@ Vec3 support_hessian_forms(const S& s, const Vec3& m, const Vec3& p, const Vec3&
 // of two surface points), so G(n) <= d <= |sep|. G is concave on R^3 (a linear term minus two
 // support functions), and on the unit sphere its Hessian is -(H_A + H_B) - G P, with H the
 // lab-frame support Hessians (the principal radii of curvature at the support points) and P
-// the tangential projection. Newton steps on the sphere, from `start` (or the line of centres):
+// the tangential projection. Newton steps on the sphere, from `start` (or the line of centres;
+// for rods the direction between their core segments, geometry/segment.hpp):
 //     (H_A + H_B + max(G, l) P) delta = P sep,   n <- normalise(n + delta),
 // delta tangent and at most 1/2 rad, halved until G increases (l: a small length that keeps
 // the system definite where G < 0 or a radius of curvature vanishes). For elongated bodies the
 // radii differ by (a/b)^2 between directions, which is why plain gradient ascent needs many
 // steps there. Stops once the gap reaches `enough`, once |sep| - G <= max(tol, rel_tol G) (the
 // gap is within that of the distance), or after `iterations` evaluations of G (each two support
-// points). The same Newton step, in the relative frame and run to convergence, is the distance
-// solver's support stage (geometry/distance.hpp, support_maximum);
+// points). The search runs in A's body frame (two matrix-vector products per evaluation
+// instead of four). The same Newton step, in the relative frame and run to convergence, is the
+// distance solver's support stage (geometry/distance.hpp, support_maximum);
 // returns the best axis and its gap in `gap`; `scale` scales both shapes (growth). Zero vector
 // if the centres coincide.
 template <SupportShape SA, SupportShape SB>
 Vec3 separating_axis(const SA& sa, const Motion& a, const SB& sb, const Motion& b, double tau,
                      int iterations, double& gap, double enough = kInf, double scale = 1.0,
                      const Vec3* start = nullptr, double tol = 0.0, double rel_tol = 0.0) {
-  const Vec3 c = (b.initial().r - a.initial().r) + (b.initial().v - a.initial().v) * tau;
+  const Vec3 c_lab = (b.initial().r - a.initial().r) + (b.initial().v - a.initial().v) * tau;
   gap = -kInf;
-  if (!(c.squaredNorm() > 0.0)) return Vec3::Zero();
-  const Mat3 Ra = a.rotation(tau), Rb = b.rotation(tau);
+  if (!(c_lab.squaredNorm() > 0.0)) return Vec3::Zero();
+  // Everything in A's body frame: directions n there are A's support directions themselves,
+  // B's are -Rab^T n (Rab = Ra^T Rb takes B's frame to A's), and the gradient is
+  // sep = c + Rab x_B - x_A (c the centre separation in A's frame).
+  const Quat rot_a = a.orientation(tau);
+  const Quat rot_a_inv = rot_a.conjugate();
+  const Mat3 Rab = (rot_a_inv * b.orientation(tau)).toRotationMatrix();
+  const Vec3 c = rot_a_inv * c_lab;
   const double l = 1e-3 * scale * std::min(sa.inscribed_radius(), sb.inscribed_radius());
-  // body-frame directions and support points of the last accepted evaluation
-  Vec3 ma, mb, pa, pb;
-  auto eval = [&](const Vec3& n, Vec3& sep, Vec3& ua, Vec3& ub, Vec3& qa, Vec3& qb) {
-    ua = Ra.transpose() * n;
-    ub = -(Rb.transpose() * n);
-    qa = sa.support_point(ua);
+  // B's body-frame direction and the support points of the last accepted evaluation
+  Vec3 mb, pa, pb;
+  auto eval = [&](const Vec3& n, Vec3& sep, Vec3& ub, Vec3& qa, Vec3& qb) {
+    ub = -(Rab.transpose() * n);
+    qa = sa.support_point(n);
     qb = sb.support_point(ub);
-    sep = c + scale * (Rb * qb - Ra * qa);
+    sep = c + scale * (Rab * qb - qa);
     return n.dot(sep);
   };
   Vec3 best = c.normalized();
-  if (start && start->squaredNorm() > 0.0) best = start->normalized();
+  if (start && start->squaredNorm() > 0.0) {
+    best = (rot_a_inv * *start).normalized();
+  } else {
+    // Rods (a body whose core segment is longer than its thickness, geometry/segment.hpp):
+    // start from the direction between the closest points of the core segments instead of
+    // the line of centres. It needs fewer Newton steps for long bodies (ellipsoids at
+    // phi = 0.4: 3.0 gap evaluations per search instead of 4.5 at X0 = 10), not for short ones
+    // (X0 = 2: the line of centres is as good and the segments cost more than they save).
+    const CoreSegment ka = core_segment(sa.half_extents()), kb = core_segment(sb.half_extents());
+    if (ka.rod() || kb.rod()) {
+      const Vec3 u = Vec3::Unit(ka.axis), v = Rab.col(kb.axis);
+      const SegmentPoints sp =
+          closest_segment_points(Vec3::Zero(), u, scale * ka.half, c, v, scale * kb.half);
+      const Vec3 dir = c + sp.t * v - sp.s * u;
+      if (dir.squaredNorm() > 1e-6 * c.squaredNorm()) best = dir.normalized();
+    }
+  }
   Vec3 sep;
-  gap = eval(best, sep, ma, mb, pa, pb);
+  gap = eval(best, sep, mb, pa, pb);
   int evals = 1;
   while (evals < iterations && gap < enough && sep.norm() - gap > std::max(tol, rel_tol * gap)) {
     // tangent basis (e1, e2) at n; the support Hessians in it, each body in its own frame
     const Vec3 e1 =
         (std::abs(best.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(best).normalized();
     const Vec3 e2 = best.cross(e1);
-    const Vec3 a1 = Ra.transpose() * e1, a2 = Ra.transpose() * e2;
-    const Vec3 b1 = Rb.transpose() * e1, b2 = Rb.transpose() * e2;
-    const Vec3 fa = support_hessian_forms(sa, ma, pa, a1, a2);
+    const Vec3 b1 = Rab.transpose() * e1, b2 = Rab.transpose() * e2;
+    const Vec3 fa = support_hessian_forms(sa, best, pa, e1, e2);
     const Vec3 fb = support_hessian_forms(sb, mb, pb, b1, b2);
     const double shift = std::max(gap, l);
     const double m11 = scale * (fa[0] + fb[0]) + shift;
@@ -259,11 +282,11 @@ Vec3 separating_axis(const SA& sa, const Motion& a, const SB& sb, const Motion& 
     bool moved = false;
     while (evals < iterations) {
       const Vec3 n = (best + delta).normalized();
-      Vec3 s, ua, ub, qa, qb;
-      const double g = eval(n, s, ua, ub, qa, qb);
+      Vec3 s, ub, qa, qb;
+      const double g = eval(n, s, ub, qa, qb);
       ++evals;
       if (g > gap) {
-        best = n, sep = s, gap = g, ma = ua, mb = ub, pa = qa, pb = qb;
+        best = n, sep = s, gap = g, mb = ub, pa = qa, pb = qb;
         moved = true;
         break;
       }
@@ -272,7 +295,7 @@ Vec3 separating_axis(const SA& sa, const Motion& a, const SB& sb, const Motion& 
     }
     if (!moved) break;  // no increase along the Newton direction: G is at its maximum to rounding
   }
-  return best;
+  return rot_a * best;
 }
 
 }  // namespace hb
