@@ -53,7 +53,8 @@
 //  conservative steps, the larger of g / K_n and the positive root of g + g' dt - M dt^2 / 2
 //  (lipschitz_step and curvature_step of contact/first_root.hpp):
 //   a. before the first distance solve, along an axis found by Newton steps on the gap over
-//      directions (`separating_axis`: from the line of centres, until the gap rules the
+//      directions (`separating_axis`: from the line of centres -- for rods, from the closest
+//      points of their core segments, geometry/segment.hpp -- until the gap rules the
 //      window out or is within axis_rel_tol of the distance), re-aimed from the last axis
 //      where the gap runs low; a pair that cannot meet inside the window costs no distance
 //      solve, and a pair that meets reaches its first solve within ~eps_d of contact, which
