@@ -220,9 +220,14 @@ Vec3 separating_axis(const SA& sa, const Motion& a, const SB& sb, const Motion& 
   // Everything in A's body frame: directions n there are A's support directions themselves,
   // B's are -Rab^T n (Rab = Ra^T Rb takes B's frame to A's), and the gradient is
   // sep = c + Rab x_B - x_A (c the centre separation in A's frame).
-  const Quat rot_a = a.orientation(tau);
+  // At tau = 0 (the usual first search: the window starts at the states' time) a spherical top
+  // is at its initial orientation; no rotation increment to form.
+  auto orientation = [tau](const Motion& m) {
+    return tau == 0.0 && m.spherical() ? m.initial().q : m.orientation(tau);
+  };
+  const Quat rot_a = orientation(a);
   const Quat rot_a_inv = rot_a.conjugate();
-  const Mat3 Rab = (rot_a_inv * b.orientation(tau)).toRotationMatrix();
+  const Mat3 Rab = (rot_a_inv * orientation(b)).toRotationMatrix();
   const Vec3 c = rot_a_inv * c_lab;
   const double l = 1e-3 * scale * std::min(sa.inscribed_radius(), sb.inscribed_radius());
   // B's body-frame direction and the support points of the last accepted evaluation
