@@ -21,10 +21,18 @@ namespace hb {
 
 struct Ellipsoid {
   static constexpr const char* kName = "ellipsoid";
+  // The semi-axes: set them through the constructor (the squares and inverse squares the
+  // solvers use at every evaluation are kept beside them; three divisions per f, grad or
+  // Hessian otherwise). Read-only in practice: a shape is rebuilt, never edited.
   double a = 1.0, b = 1.0, c = 1.0;
 
-  Vec3 inv_sq() const { return Vec3(1.0 / (a * a), 1.0 / (b * b), 1.0 / (c * c)); }
-  Vec3 sq() const { return Vec3(a * a, b * b, c * c); }
+  Ellipsoid() = default;
+  Ellipsoid(double a_, double b_, double c_)
+      : a(a_), b(b_), c(c_), sq_(a_ * a_, b_ * b_, c_ * c_),
+        inv_sq_(1.0 / (a_ * a_), 1.0 / (b_ * b_), 1.0 / (c_ * c_)) {}
+
+  const Vec3& inv_sq() const { return inv_sq_; }
+  const Vec3& sq() const { return sq_; }
 
   double f(const Vec3& x) const { return x.cwiseProduct(x).dot(inv_sq()) - 1.0; }
   Vec3 grad(const Vec3& x) const { return 2.0 * x.cwiseProduct(inv_sq()); }
@@ -58,6 +66,9 @@ struct Ellipsoid {
     const Vec3 Mu = u.cwiseProduct(sq());
     return Vec3(u.dot(Mu) - pu * pu, v.dot(Mu) - pu * pv, v.dot(v.cwiseProduct(sq())) - pv * pv) / h;
   }
+
+ private:
+  Vec3 sq_ = Vec3::Ones(), inv_sq_ = Vec3::Ones();
 };
 
 struct Sphere {
