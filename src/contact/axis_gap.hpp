@@ -210,24 +210,21 @@ Vec3 support_hessian_forms(const S& s, const Vec3& m, const Vec3& p, const Vec3&
 // distance solver's support stage (geometry/distance.hpp, support_maximum);
 // returns the best axis and its gap in `gap`; `scale` scales both shapes (growth). Zero vector
 // if the centres coincide.
+// The search for bodies at rest in orientations rot_a, rot_b (body -> lab) with centre
+// separation c_lab = r_B - r_A; separating_axis below places moving bodies at time tau and calls
+// it, and a collision's distance solve starts from its support points (touching_guess).
 template <SupportShape SA, SupportShape SB>
-Vec3 separating_axis(const SA& sa, const Motion& a, const SB& sb, const Motion& b, double tau,
-                     int iterations, double& gap, double enough = kInf, double scale = 1.0,
-                     const Vec3* start = nullptr, double tol = 0.0, double rel_tol = 0.0) {
-  const Vec3 c_lab = (b.initial().r - a.initial().r) + (b.initial().v - a.initial().v) * tau;
+Vec3 separating_axis_at(const SA& sa, const Quat& rot_a, const SB& sb, const Quat& rot_b,
+                        const Vec3& c_lab, int iterations, double& gap, double enough = kInf,
+                        double scale = 1.0, const Vec3* start = nullptr, double tol = 0.0,
+                        double rel_tol = 0.0) {
   gap = -kInf;
   if (!(c_lab.squaredNorm() > 0.0)) return Vec3::Zero();
   // Everything in A's body frame: directions n there are A's support directions themselves,
   // B's are -Rab^T n (Rab = Ra^T Rb takes B's frame to A's), and the gradient is
   // sep = c + Rab x_B - x_A (c the centre separation in A's frame).
-  // At tau = 0 (the usual first search: the window starts at the states' time) a spherical top
-  // is at its initial orientation; no rotation increment to form.
-  auto orientation = [tau](const Motion& m) {
-    return tau == 0.0 && m.spherical() ? m.initial().q : m.orientation(tau);
-  };
-  const Quat rot_a = orientation(a);
   const Quat rot_a_inv = rot_a.conjugate();
-  const Mat3 Rab = (rot_a_inv * orientation(b)).toRotationMatrix();
+  const Mat3 Rab = (rot_a_inv * rot_b).toRotationMatrix();
   const Vec3 c = rot_a_inv * c_lab;
   const double l = 1e-3 * scale * std::min(sa.inscribed_radius(), sb.inscribed_radius());
   // B's body-frame direction and the support points of the last accepted evaluation
@@ -301,6 +298,20 @@ Vec3 separating_axis(const SA& sa, const Motion& a, const SB& sb, const Motion& 
     if (!moved) break;  // no increase along the Newton direction: G is at its maximum to rounding
   }
   return rot_a * best;
+}
+
+template <SupportShape SA, SupportShape SB>
+Vec3 separating_axis(const SA& sa, const Motion& a, const SB& sb, const Motion& b, double tau,
+                     int iterations, double& gap, double enough = kInf, double scale = 1.0,
+                     const Vec3* start = nullptr, double tol = 0.0, double rel_tol = 0.0) {
+  const Vec3 c_lab = (b.initial().r - a.initial().r) + (b.initial().v - a.initial().v) * tau;
+  // At tau = 0 (the usual first search: the window starts at the states' time) a spherical top
+  // is at its initial orientation; no rotation increment to form.
+  auto orientation = [tau](const Motion& m) {
+    return tau == 0.0 && m.spherical() ? m.initial().q : m.orientation(tau);
+  };
+  return separating_axis_at(sa, orientation(a), sb, orientation(b), c_lab, iterations, gap, enough,
+                            scale, start, tol, rel_tol);
 }
 
 }  // namespace hb

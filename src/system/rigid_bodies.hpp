@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 
 #include "collision/rigid.hpp"
 #include "contact/contact_time.hpp"
@@ -110,6 +111,25 @@ CollisionContact collision_contact(const BodyState& a, const BodyState& b, const
   }
   if (c.d.status == DistanceStatus::fallback) ++stats.collision_distance_fallbacks;
   return c;
+}
+
+// The distance solve at a collision of shapes sa, sb at poses pa, pb (orientations qa, qb):
+// with `guess`, shapes with a support function (not two spheres: their distance is closed-form)
+// start from the support points of the separating axis (touching_guess, contact_time.hpp)
+// instead of the solver's cold guess: at X0 = 2 the solve costs about a third as much. Without,
+// or if that start does not converge, the solver's own stages run as before.
+template <Shape SA, Shape SB>
+DistanceResult collision_distance(const SA& sa, const Quat& qa, const Pose& pa, const SB& sb,
+                                  const Quat& qb, const Pose& pb, const DistanceOptions& o,
+                                  bool guess) {
+  if constexpr (SupportShape<SA> && SupportShape<SB> &&
+                !(std::is_same_v<SA, Sphere> && std::is_same_v<SB, Sphere>)) {
+    if (guess) {
+      const DistanceWarmStart w = touching_guess(sa, qa, sb, qb, Vec3(pb.r - pa.r));
+      return distance(sa, pa, sb, pb, o, w.valid ? &w : nullptr);
+    }
+  }
+  return distance(sa, pa, sb, pb, o);
 }
 
 // The prediction loop of the rigid pair models (RigidBodies, RigidMixture): body i (at `now`)
@@ -246,9 +266,10 @@ struct RigidBodies {
     const auto [r_ab, d] = collision_contact(
         a, b, box, i, j, stats,
         [&](const Pose& pa, const Pose& pb) {
-          if (sc == 1.0) return distance(shape, pa, shape, pb, options.distance);
+          const bool guess = options.separating_axis;
+          if (sc == 1.0) return collision_distance(shape, a.q, pa, shape, b.q, pb, options.distance, guess);
           const auto shp = scaled_shape(shape, sc);
-          return distance(shp, pa, shp, pb, options.distance);
+          return collision_distance(shp, a.q, pa, shp, b.q, pb, options.distance, guess);
         },
         [&] {
           const std::string js = hb::shape_json(AnyShape(resized(shape, sc)));

@@ -136,8 +136,10 @@ struct RigidMixture {
         [&](const Pose& pa, const Pose& pb) {
           return std::visit(
               [&](const auto& A, const auto& B) {
-                if (sc == 1.0) return distance(A, pa, B, pb, options.distance);
-                return distance(resized(A, sc), pa, resized(B, sc), pb, options.distance);
+                const bool guess = options.separating_axis;
+                if (sc == 1.0) return collision_distance(A, a.q, pa, B, b.q, pb, options.distance, guess);
+                return collision_distance(resized(A, sc), a.q, pa, resized(B, sc), b.q, pb,
+                                          options.distance, guess);
               },
               sa, sb);
         },

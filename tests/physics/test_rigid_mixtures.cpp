@@ -3,7 +3,7 @@
 //  - triaxial ellipsoids [1.5, 1.0, 0.6] with their uniform-density inertia (asymmetric tops) at
 //    phi = 0.40: the rotational temperature of each principal axis equals the translational one
 //    (equipartition; tests the tensor impulse and the exact free rotation together), energy drift
-//    below 1e-12 over 1.5 10^5 collisions (10^6 in scripts/validate.sh), no overlap;
+//    below 1e-12 over 3 10^5 collisions (10^6 in scripts/validate.sh), no overlap;
 //  - an equimolar sphere–ellipsoid mixture at low density: Z - 1 = B2* phi + O(phi^2) with B2* of
 //    the mixture from the exact convex-body excluded volumes v_i + v_j + R_i S_j + R_j S_i
 //    (convex_virial.hpp), from two densities extrapolated linearly in phi.
@@ -24,7 +24,7 @@ TEST(RigidPhysics, TriaxialEllipsoidsShareEnergyEquallyOverThePrincipalAxes) {
   const std::string cfg =
       "[system]\npacking_fraction = 0.40\nseed = 3\n"
       "[[species]]\nname = \"T\"\ncount = 256\nshape = { type = \"ellipsoid\", semi_axes = [1.5, 1.0, 0.6] }\n"
-      "[run]\nequilibrate_time = 20.0\ntime = 100000.0\nmax_collisions = 150000\n"
+      "[run]\nequilibrate_time = 20.0\ntime = 100000.0\nmax_collisions = 300000\n"
       "[neighbors]\nmethod = \"nnl\"\nshell = 0.15\n"
       "[output]\nlog_interval = 2.0\nsnapshot_interval = 100000.0\n";
   const auto s = run_config("triaxial-040", cfg);
@@ -34,16 +34,21 @@ TEST(RigidPhysics, TriaxialEllipsoidsShareEnergyEquallyOverThePrincipalAxes) {
   EXPECT_NEAR(sp["inertia"][2].get<double>(), (2.25 + 1.0) / 5.0, 1e-12);
   const double tt = sp["temperature_translational"], et = sp["temperature_translational_error"];
   std::printf("  %lld collisions, T_trans %.4f +- %.4f, T_rot axes", s["collisions"].get<long long>(), tt, et);
+  // Three axes, each within 4 sigma: a false alarm about once in 5000 runs for Gaussian errors
+  // (3 sigma per axis, over 1.5 10^5 collisions, failed once, at 3.6 sigma, on a trajectory
+  // whose continuation to 8 10^5 collisions came within 0.4 sigma: each change of the engine's
+  // rounding draws a new realisation). Over 3 10^5 collisions the error bars (~0.011) still
+  // make a 7 % difference more than 4 sigma.
   for (int k = 0; k < 3; ++k) {
     const double tk = sp["temperature_rotational_axes"][k], ek = sp["temperature_rotational_axes_error"][k];
     std::printf(" %.4f +- %.4f", tk, ek);
     EXPECT_GT(ek, 0.0);
-    EXPECT_LT(ek, 0.025);  // the test can tell a 7 % difference
-    EXPECT_NEAR(tk, tt, 3.0 * std::hypot(ek, et)) << "axis " << k;
+    EXPECT_LT(4.0 * std::hypot(ek, et), 0.07);  // the test can tell a 7 % difference
+    EXPECT_NEAR(tk, tt, 4.0 * std::hypot(ek, et)) << "axis " << k;
   }
   std::printf(", drift %.2e, Z %.4f +- %.4f\n", s["energy_drift"].get<double>(), s["Z"].get<double>(),
               s["Z_error"].get<double>());
-  EXPECT_GE(s["collisions"].get<double>(), 1.5e5);  // (10^6: scripts/validate.sh)
+  EXPECT_GE(s["collisions"].get<double>(), 3e5);  // (10^6: scripts/validate.sh)
   EXPECT_LT(std::abs(s["energy_drift"].get<double>()), 1e-12);
   EXPECT_EQ(s["overlaps"], 0);
 }
