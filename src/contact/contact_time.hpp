@@ -45,6 +45,12 @@
 //     zero to tolerance; otherwise (fallback, counted) the bracket is shrunk on the sign of
 //     d(t) (Illinois + bisection) and its left end, where d > 0, is returned: a time never later
 //     than the contact.
+//  4'. (beyond the paper; ContactOptions::contact_ahead) A sample with 0 < d < eps_d and d' < 0
+//     whose rate step would end past the time d / |d'| ahead tries the Newton of step 4 first,
+//     from its own closest points at that time, kept to the step: a root there at which the
+//     distance is zero and the bodies approach is the contact (Solver::solve_ahead), and the
+//     sample that would have bracketed it is saved (a third of the distance solves of a hit).
+//     Otherwise the step is taken as above.
 //  Separating-axis advancement (beyond the paper; shapes with a support function; with growth
 //  the gap and its bounds carry the scale law, axis_gap.hpp).
 //  The gap g_n(t) along a fixed unit vector n (contact/axis_gap.hpp) is a lower bound of the
@@ -157,6 +163,9 @@ struct ContactOptions {
   int brent_max_evals = 60;
   double accept_tol = 1e-10;    // NR contact accepted if |d(t_c)| <= accept_tol * L
   bool separating_axis = true;  // separating-axis advancement (false: the paper's stepping only)
+  // Newton on the contact system from a sample within eps_d of contact, before the sample that
+  // would bracket it (step 4' of the header; false: always bracket first, the paper's way).
+  bool contact_ahead = true;
   // The axis search before the first distance solve (step a of the header): at most this many
   // gap evaluations per search, stopped once the gap is within axis_rel_tol of the distance.
   int axis_evals = 12;
@@ -179,6 +188,7 @@ struct ContactResult {
   int fallbacks = 0;            // NR rejected, bracket shrunk on the sign of d(t) instead
   int distance_fallbacks = 0;   // distance solves that needed a fallback stage
   int axis_steps = 0;           // separating-axis steps (support-function evaluations pairs)
+  int ahead = 0;                // contacts found by Newton ahead of a sample (step 4')
   DistanceWarmStart warm;       // last distance solution (warm start for the next prediction)
 };
 
@@ -522,43 +532,71 @@ struct Solver {
   // Contact NR from the bracket [lo, hi] (d(lo) > 0 > d(hi)); fallback: shrink the bracket.
   // The NR starts at the secant time with the closest points and multiplier of the end nearer
   // to contact (no distance solve: the bracket is at most one rate step eps_d / K wide).
-  void solve_bracket(const Sample& l, const Sample& h) {
-    const double t0 = l.t + (h.t - l.t) * l.d / (l.d - h.d);
-    const Sample& g = l.d <= -h.d ? l : h;
-    Vec5c y;
-    y << 0.5 * (g.res.point_a + g.res.point_b), std::max(g.res.alpha, 1e-3), t0;
+  // Newton-Raphson on the contact system from y = (x, alpha, t); true if it converged with t
+  // inside [t_lo, t_hi] (a step that leaves it ends the iteration).
+  bool contact_newton(Vec5c& y, double t_lo, double t_hi) {
     const double dt_tol = 1e-12 * L / std::max(K, 1e-300);
-    bool ok = false;
     for (int it = 0; it < o.max_nr_iter; ++it) {
       ++out.nr_iterations;
       Vec5c F;
       Mat5c J;
       contact_system(A, B, y, F, &J);
       Vec5c dy = SmallLU<5>(J).solve(-F);
-      if (!dy.allFinite()) break;
+      if (!dy.allFinite()) return false;
       const double dx = dy.head<3>().norm();
       double xi = 1.0;
       if (dx > 0.5 * L) xi = 0.5 * L / dx;
       if (std::abs(dy[3]) > 0.5 * std::abs(y[3])) xi = std::min(xi, 0.5 * std::abs(y[3] / dy[3]));
       y += xi * dy;
-      if (y[4] < l.t - dt_tol || y[4] > h.t + dt_tol) break;  // left the bracket
-      if (xi == 1.0 && dx <= 1e-12 * L && std::abs(dy[4]) <= dt_tol) {
-        ok = true;
-        break;
-      }
+      if (y[4] < t_lo - dt_tol || y[4] > t_hi + dt_tol) return false;  // left the interval
+      if (xi == 1.0 && dx <= 1e-12 * L && std::abs(dy[4]) <= dt_tol) return true;
     }
-    if (ok) {
-      const double tc = std::clamp(y[4], l.t, h.t);
-      const Sample c = eval(tc);
+    return false;
+  }
+
+  // The Newton result y (time in [t_lo, t_hi]) checked by a distance solve there: a contact if
+  // the distance is zero to accept_tol and, with `entering`, the bodies approach (d' < 0).
+  // Reports the hit and returns true; false otherwise (or if the solve failed: `failed`).
+  bool accept_newton(const Vec5c& y, double t_lo, double t_hi, bool entering) {
+    const double tc = std::clamp(y[4], t_lo, t_hi);
+    const Sample c = eval(tc);
+    if (failed) return false;
+    if (!(std::abs(c.d) <= o.accept_tol * L) || (entering && !(c.dd < 0.0))) return false;
+    double f_, ft_;
+    Vec3 g_, gt_;
+    Mat3 h_;
+    A.eval(y.head<3>(), tc, f_, g_, h_, ft_, gt_);
+    report_hit(tc, y.head<3>(), g_.normalized());
+    return true;
+  }
+
+  // Step 4' (beyond the paper): from a sample s with 0 < d < eps_d, approaching, whose rate step
+  // ends at t1, Newton on the contact system from s's closest points and multiplier at the
+  // time the rate extrapolates to (t = s.t + d / |d'|), without the distance sample at t1
+  // that would bracket the contact first. Accepted as solve_bracket accepts a root (time in
+  // the step, distance there zero to tolerance) and only if the bodies approach there (d' < 0:
+  // the entry into contact, not the exit from a dip). No contact can start before
+  // s.t + d / K, so like a bracket's root the time is the first contact up to roots closer
+  // together than the step (eps_d / K). Anything else: false, and the caller steps as before.
+  bool solve_ahead(const Sample& s, double t1) {
+    const double t0 = s.t + s.d / -s.dd;
+    if (!(t0 <= t1)) return false;  // the rate does not reach contact within the step
+    Vec5c y;
+    y << 0.5 * (s.res.point_a + s.res.point_b), std::max(s.res.alpha, 1e-3), t0;
+    if (!contact_newton(y, s.t, t1)) return false;
+    if (!accept_newton(y, s.t, t1, true)) return false;
+    ++out.ahead;
+    return true;
+  }
+
+  void solve_bracket(const Sample& l, const Sample& h) {
+    const double t0 = l.t + (h.t - l.t) * l.d / (l.d - h.d);
+    const Sample& g = l.d <= -h.d ? l : h;
+    Vec5c y;
+    y << 0.5 * (g.res.point_a + g.res.point_b), std::max(g.res.alpha, 1e-3), t0;
+    if (contact_newton(y, l.t, h.t)) {
+      if (accept_newton(y, l.t, h.t, false)) return;
       if (failed) return;
-      if (std::abs(c.d) <= o.accept_tol * L) {
-        double f_, ft_;
-        Vec3 g_, gt_;
-        Mat3 h_;
-        A.eval(y.head<3>(), tc, f_, g_, h_, ft_, gt_);
-        report_hit(tc, y.head<3>(), g_.normalized());
-        return;
-      }
     }
     // Fallback: shrink the bracket on the sign of d(t); return its left end (d > 0).
     ++out.fallbacks;
@@ -662,6 +700,10 @@ struct Solver {
       // reaches the window's end there is nothing left to look at (saves the last solve).
       if (s.d >= in.eps_d && s.t + dt >= hi) break;
       const double t1 = std::min(s.t + dt, hi);
+      if (o.contact_ahead && s.d > 0.0 && s.d < in.eps_d && s.dd < 0.0) {
+        if (solve_ahead(s, t1)) return;
+        if (failed) return;
+      }
       const Sample s1 = eval(t1);
       if (failed) return;
       // A negative sample at rounding level between two samples where d increases is noise

@@ -292,6 +292,40 @@ TEST(Contact, SymmetricInAandB) {
   }
 }
 
+// Step 4' (Newton ahead of a sample, contact_ahead) against the bracketed path it shortcuts:
+// every scenario kind (approaching, fast spinners, grazing passes with and without rotation,
+// just touching), the same status and the same time, and the shortcut taken in most hits.
+TEST(Contact, NewtonAheadAgreesWithTheBracketedPath) {
+  Rng r(50);
+  ContactOptions off;
+  off.contact_ahead = false;
+  int hits = 0, ahead = 0, n = 0;
+  long evals_on = 0, evals_off = 0;
+  double worst = 0.0;
+  for (int kind = 0; kind <= 4; ++kind)
+    for (int k = 0; k < scaled_count(600, 0.01, 4); ++k) {
+      const Scenario s = make_scenario(r, kind);
+      const ContactInput<Ellipsoid, Ellipsoid> in{s.a, s.b, s.sa, s.sb, 0.0, 0.0, s.t_max, 1e-5};
+      const ContactResult on = contact_time(in), ref = contact_time(in, off);
+      ++n;
+      EXPECT_EQ(ref.ahead, 0);
+      ASSERT_EQ(on.status, ref.status) << "kind " << kind << " k " << k;
+      evals_on += on.distance_evals;
+      evals_off += ref.distance_evals;
+      if (on.status != ContactStatus::hit) continue;
+      ++hits;
+      ahead += on.ahead;
+      worst = std::max(worst, std::abs(on.time - ref.time) / std::max(1.0, ref.time));
+      EXPECT_LE((on.normal - ref.normal).norm(), 1e-6) << "kind " << kind << " k " << k;
+    }
+  std::printf("  %d pairs, %d hits, %d found ahead; distance evals %.2f -> %.2f per pair; "
+              "max |t_ahead - t_bracket| %.1e\n",
+              n, hits, ahead, double(evals_off) / n, double(evals_on) / n, worst);
+  EXPECT_LE(worst, 1e-10);
+  EXPECT_GE(ahead, hits / 2);  // the shortcut is the usual path
+  EXPECT_LT(evals_on, evals_off);
+}
+
 // Just after a collision the pair touches (d ~ -1e-15) and separates: no spurious contact at
 // t = 0; the same pair approaching is a contact at once (initial overlap).
 TEST(Contact, TouchingPairSeparatingIsNotAContact) {
