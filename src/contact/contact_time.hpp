@@ -49,8 +49,12 @@
 //     whose rate step would end past the time d / |d'| ahead tries the Newton of step 4 first,
 //     from its own closest points at that time, kept to the step: a root there at which the
 //     distance is zero and the bodies approach is the contact (Solver::solve_ahead), and the
-//     sample that would have bracketed it is saved (a third of the distance solves of a hit).
-//     Otherwise the step is taken as above.
+//     sample that would have bracketed it is saved. The same Newton runs first from the end of
+//     the axis leaps of step a (curved pairs: the gap g < eps_d of the last axis and its rate
+//     g' < 0 give the start, the support points the contact point), which saves the first
+//     distance solve too (Solver::solve_ahead_of_axis). The distance solve that accepts a
+//     Newton root starts from the root's contact point (one NR iteration). A hit then costs
+//     one distance solve instead of three. Otherwise the step is taken as above.
 //  Separating-axis advancement (beyond the paper; shapes with a support function; with growth
 //  the gap and its bounds carry the scale law, axis_gap.hpp).
 //  The gap g_n(t) along a fixed unit vector n (contact/axis_gap.hpp) is a lower bound of the
@@ -479,6 +483,8 @@ struct Solver {
   double advance_on_axis(const Sample& s, double hi) { return advance_on_axis(s.res.normal, s.t, hi); }
 
   Vec3 axis_ma = Vec3::Zero(), axis_mb = Vec3::Zero();  // body-frame axes of the last gap
+  double axis_g = kInf, axis_slope = 0.0;  // the last gap and its rate (curved pairs)
+  bool axis_curved = false;
 
   // The same along the unit vector n from time t0 (gap, rate and curvature bounds:
   // contact/axis_gap.hpp).
@@ -519,6 +525,7 @@ struct Solver {
       g = G.value(t, slope, axis_ma, axis_mb);
       ++out.axis_steps;
     }
+    axis_g = g, axis_slope = slope, axis_curved = G.is_curved();
     return t;
   }
 
@@ -559,6 +566,14 @@ struct Solver {
   // Reports the hit and returns true; false otherwise (or if the solve failed: `failed`).
   bool accept_newton(const Vec5c& y, double t_lo, double t_hi, bool entering) {
     const double tc = std::clamp(y[4], t_lo, t_hi);
+    // The distance solve starts from the Newton point: both closest points there (touching),
+    // the multiplier alpha of the contact system (the distance solver's own, beta = 0).
+    if (!grow) {
+      const Pose pa = A.pose_at(tc), pb = B.pose_at(tc);
+      const Vec3 x = y.head<3>();
+      warm = DistanceWarmStart{pa.R.transpose() * (x - pa.r), pb.R.transpose() * (x - pb.r),
+                               std::abs(y[3]), 0.0, true};
+    }
     const Sample c = eval(tc);
     if (failed) return false;
     if (!(std::abs(c.d) <= o.accept_tol * L) || (entering && !(c.dd < 0.0))) return false;
@@ -578,6 +593,31 @@ struct Solver {
   // the entry into contact, not the exit from a dip). No contact can start before
   // s.t + d / K, so like a bracket's root the time is the first contact up to roots closer
   // together than the step (eps_d / K). Anything else: false, and the caller steps as before.
+  // Step 4' from the end of the axis leaps (curved pairs, no growth): the gap g < eps_d of the
+  // last axis at lo, approaching (g' < 0), and no contact before lo. The Newton starts from
+  // the midpoint of the support points along the axis, alpha from their gradients, at
+  // lo + g / |g'|, kept to [lo, lo + eps_d / K] (the rate step from a distance below eps_d); the
+  // root is accepted as in solve_ahead. Saves the distance solve at lo.
+  bool solve_ahead_of_axis(double lo, double hi) {
+    if constexpr (kAxis) {
+      if (grow || !axis_curved || !(axis_g >= 0.0 && axis_g < in.eps_d && axis_slope < 0.0))
+        return false;
+      const double t1 = std::min(lo + in.eps_d / K, hi);
+      const Pose pa = A.pose_at(lo), pb = B.pose_at(lo);
+      const Vec3 ya = in.shape_a.support_point(axis_ma), yb = in.shape_b.support_point(axis_mb);
+      const double ga = in.shape_a.grad(ya).norm(), gb = in.shape_b.grad(yb).norm();
+      if (!(ga > 0.0 && gb > 0.0)) return false;
+      Vec5c y;
+      y << 0.5 * (pa.r + pa.R * ya + pb.r + pb.R * yb), std::sqrt(ga / gb),
+          std::min(lo + axis_g / -axis_slope, t1);
+      if (!contact_newton(y, lo, t1)) return false;
+      if (!accept_newton(y, lo, t1, true)) return false;
+      ++out.ahead;
+      return true;
+    }
+    return false;
+  }
+
   bool solve_ahead(const Sample& s, double t1) {
     const double t0 = s.t + s.d / -s.dd;
     if (!(t0 <= t1)) return false;  // the rate does not reach contact within the step
@@ -663,6 +703,8 @@ struct Solver {
                                  /*guess=*/true};
         warm_scale = sc;
       }
+      if (o.separating_axis && o.contact_ahead && solve_ahead_of_axis(lo, hi)) return;
+      if (failed) return;
     }
     Sample s = eval(lo);
     if (failed) return;

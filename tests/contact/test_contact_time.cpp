@@ -292,9 +292,10 @@ TEST(Contact, SymmetricInAandB) {
   }
 }
 
-// Step 4' (Newton ahead of a sample, contact_ahead) against the bracketed path it shortcuts:
-// every scenario kind (approaching, fast spinners, grazing passes with and without rotation,
-// just touching), the same status and the same time, and the shortcut taken in most hits.
+// Step 4' (Newton ahead of a sample or of the last axis leap, contact_ahead) against the
+// bracketed path it shortcuts: every scenario kind (approaching, fast spinners, grazing passes
+// with and without rotation, just touching), the same status and the same time, and the
+// shortcut taken in most hits.
 TEST(Contact, NewtonAheadAgreesWithTheBracketedPath) {
   Rng r(50);
   ContactOptions off;
