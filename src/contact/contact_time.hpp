@@ -536,9 +536,6 @@ struct Solver {
     out.normal = n;
   }
 
-  // Contact NR from the bracket [lo, hi] (d(lo) > 0 > d(hi)); fallback: shrink the bracket.
-  // The NR starts at the secant time with the closest points and multiplier of the end nearer
-  // to contact (no distance solve: the bracket is at most one rate step eps_d / K wide).
   // Newton-Raphson on the contact system from y = (x, alpha, t); true if it converged with t
   // inside [t_lo, t_hi] (a step that leaves it ends the iteration).
   bool contact_newton(Vec5c& y, double t_lo, double t_hi) {
@@ -585,14 +582,6 @@ struct Solver {
     return true;
   }
 
-  // Step 4' (beyond the paper): from a sample s with 0 < d < eps_d, approaching, whose rate step
-  // ends at t1, Newton on the contact system from s's closest points and multiplier at the
-  // time the rate extrapolates to (t = s.t + d / |d'|), without the distance sample at t1
-  // that would bracket the contact first. Accepted as solve_bracket accepts a root (time in
-  // the step, distance there zero to tolerance) and only if the bodies approach there (d' < 0:
-  // the entry into contact, not the exit from a dip). No contact can start before
-  // s.t + d / K, so like a bracket's root the time is the first contact up to roots closer
-  // together than the step (eps_d / K). Anything else: false, and the caller steps as before.
   // Step 4' from the end of the axis leaps (curved pairs, no growth): the gap g < eps_d of the
   // last axis at lo, approaching (g' < 0), and no contact before lo. The Newton starts from
   // the midpoint of the support points along the axis, alpha from their gradients, at
@@ -618,6 +607,14 @@ struct Solver {
     return false;
   }
 
+  // Step 4' (beyond the paper): from a sample s with 0 < d < eps_d, approaching, whose rate step
+  // ends at t1, Newton on the contact system from s's closest points and multiplier at the
+  // time the rate extrapolates to (t = s.t + d / |d'|), without the distance sample at t1
+  // that would bracket the contact first. Accepted as solve_bracket accepts a root (time in
+  // the step, distance there zero to tolerance) and only if the bodies approach there (d' < 0:
+  // the entry into contact, not the exit from a dip). No contact can start before
+  // s.t + d / K, so like a bracket's root the time is the first contact up to roots closer
+  // together than the step (eps_d / K). Anything else: false, and the caller steps as before.
   bool solve_ahead(const Sample& s, double t1) {
     const double t0 = s.t + s.d / -s.dd;
     if (!(t0 <= t1)) return false;  // the rate does not reach contact within the step
@@ -629,6 +626,9 @@ struct Solver {
     return true;
   }
 
+  // Contact NR from the bracket [lo, hi] (d(lo) > 0 > d(hi)); fallback: shrink the bracket.
+  // The NR starts at the secant time with the closest points and multiplier of the end nearer
+  // to contact (no distance solve: the bracket is at most one rate step eps_d / K wide).
   void solve_bracket(const Sample& l, const Sample& h) {
     const double t0 = l.t + (h.t - l.t) * l.d / (l.d - h.d);
     const Sample& g = l.d <= -h.d ? l : h;

@@ -116,8 +116,8 @@ CollisionContact collision_contact(const BodyState& a, const BodyState& b, const
 // The distance solve at a collision of shapes sa, sb at poses pa, pb (orientations qa, qb):
 // with `guess`, shapes with a support function (not two spheres: their distance is closed-form)
 // start from the support points of the separating axis (touching_guess, contact_time.hpp)
-// instead of the solver's cold guess: at X0 = 2 the solve costs about a third as much. Without,
-// or if that start does not converge, the solver's own stages run as before.
+// instead of the solver's cold guess: at X0 = 2 it costs half as much (NR+SD iterations
+// 11 -> 3). Without, or if that start does not converge, the solver's own stages run as before.
 template <Shape SA, Shape SB>
 DistanceResult collision_distance(const SA& sa, const Quat& qa, const Pose& pa, const SB& sb,
                                   const Quat& qb, const Pose& pb, const DistanceOptions& o,
