@@ -138,26 +138,48 @@ class AxisGap {
       mb = -(RT * n_), Wb = RT * w;
     }
     const double sc = s0_ + sdot_ * tau;
-    if (curved_) {
-      const Vec3 pa = sa_.support_point(ma), pb = sb_.support_point(mb);
-      const double h = pa.dot(ma) + pb.dot(mb);
-      slope = n_.dot(dv_) - sdot_ * h + sc * (pa.dot(Wa.cross(ma)) + pb.dot(Wb.cross(mb)));
-      return n_.dot(dr_ + dv_ * tau) - sc * h;
-    } else {
-      slope = -Kn;
-      return n_.dot(dr_ + dv_ * tau) - sc * (sa_.support(ma) + sb_.support(mb));
-    }
+    if (curved_)
+      return from_support(tau, ma, mb, sa_.support_point(ma), sb_.support_point(mb), Wa, Wb, slope);
+    slope = -Kn;
+    return n_.dot(dr_ + dv_ * tau) - sc * (sa_.support(ma) + sb_.support(mb));
   }
   double value(double t) const {
     double s;
     Vec3 ma, mb;
     return value(t, s, ma, mb);
   }
+  // The same from the body-frame directions ma, mb of the axis at time t and their support
+  // points pa, pb, found already (the end of separating_axis at that time: AxisSupport). Saves
+  // the rotations and the two support points of value(t). The gap is n.c - s (pa.ma + pb.mb)
+  // for every pair (exact support points: pa.ma is the support function).
+  double value(double t, const Vec3& ma, const Vec3& mb, const Vec3& pa, const Vec3& pb,
+               double& slope) const {
+    const double tau = t - t_state_;
+    if (!curved_) {
+      slope = -Kn;
+      return n_.dot(dr_ + dv_ * tau) - (s0_ + sdot_ * tau) * (pa.dot(ma) + pb.dot(mb));
+    }
+    Vec3 Wa = Wa_, Wb = Wb_;
+    Quat q;
+    Vec3 w;
+    if (!ma_->spherical()) ma_->pose(tau, q, w), Wa = q.conjugate() * w;
+    if (!mb_->spherical()) mb_->pose(tau, q, w), Wb = q.conjugate() * w;
+    return from_support(tau, ma, mb, pa, pb, Wa, Wb, slope);
+  }
 
  private:
-  // n rotated by -|w| tau about the unit axis k (Rodrigues)
+  // g and g' (curved pairs) from the support points pa, pb along the body-frame directions
+  // ma, mb, the body-frame angular velocities Wa, Wb at tau = t - t_state.
+  double from_support(double tau, const Vec3& ma, const Vec3& mb, const Vec3& pa, const Vec3& pb,
+                      const Vec3& Wa, const Vec3& Wb, double& slope) const {
+    const double sc = s0_ + sdot_ * tau;
+    const double h = pa.dot(ma) + pb.dot(mb);
+    slope = n_.dot(dv_) - sdot_ * h + sc * (pa.dot(Wa.cross(ma)) + pb.dot(Wb.cross(mb)));
+    return n_.dot(dr_ + dv_ * tau) - sc * h;
+  }
+  // n rotated by -|w| tau about the unit axis k (Rodrigues; tau = 0: n itself, no trigonometry)
   Vec3 back(const Vec3& k, double w, double tau) const {
-    if (w == 0.0) return n_;
+    if (w == 0.0 || tau == 0.0) return n_;
     const double th = -w * tau, c = std::cos(th), s = std::sin(th);
     return n_ * c + k.cross(n_) * s + k * (k.dot(n_) * (1.0 - c));
   }
@@ -213,11 +235,17 @@ Vec3 support_hessian_forms(const S& s, const Vec3& m, const Vec3& p, const Vec3&
 // The search for bodies at rest in orientations rot_a, rot_b (body -> lab) with centre
 // separation c_lab = r_B - r_A; separating_axis below places moving bodies at time tau and calls
 // it, and a collision's distance solve starts from its support points (touching_guess).
+// `at`, if given, receives the body-frame directions and support points of the returned axis
+// (AxisSupport: AxisGap::value takes them for the gap at the search's time).
+struct AxisSupport {
+  Vec3 ma, mb;  // the axis in A's body frame, its opposite in B's
+  Vec3 pa, pb;  // their support points (shapes at scale 1)
+};
 template <SupportShape SA, SupportShape SB>
 Vec3 separating_axis_at(const SA& sa, const Quat& rot_a, const SB& sb, const Quat& rot_b,
                         const Vec3& c_lab, int iterations, double& gap, double enough = kInf,
                         double scale = 1.0, const Vec3* start = nullptr, double tol = 0.0,
-                        double rel_tol = 0.0) {
+                        double rel_tol = 0.0, AxisSupport* at = nullptr) {
   gap = -kInf;
   if (!(c_lab.squaredNorm() > 0.0)) return Vec3::Zero();
   // Everything in A's body frame: directions n there are A's support directions themselves,
@@ -297,13 +325,15 @@ Vec3 separating_axis_at(const SA& sa, const Quat& rot_a, const SB& sb, const Qua
     }
     if (!moved) break;  // no increase along the Newton direction: G is at its maximum to rounding
   }
+  if (at) *at = AxisSupport{best, mb, pa, pb};
   return rot_a * best;
 }
 
 template <SupportShape SA, SupportShape SB>
 Vec3 separating_axis(const SA& sa, const Motion& a, const SB& sb, const Motion& b, double tau,
                      int iterations, double& gap, double enough = kInf, double scale = 1.0,
-                     const Vec3* start = nullptr, double tol = 0.0, double rel_tol = 0.0) {
+                     const Vec3* start = nullptr, double tol = 0.0, double rel_tol = 0.0,
+                     AxisSupport* at = nullptr) {
   const Vec3 c_lab = (b.initial().r - a.initial().r) + (b.initial().v - a.initial().v) * tau;
   // At tau = 0 (the usual first search: the window starts at the states' time) a spherical top
   // is at its initial orientation; no rotation increment to form.
@@ -311,7 +341,7 @@ Vec3 separating_axis(const SA& sa, const Motion& a, const SB& sb, const Motion& 
     return tau == 0.0 && m.spherical() ? m.initial().q : m.orientation(tau);
   };
   return separating_axis_at(sa, orientation(a), sb, orientation(b), c_lab, iterations, gap, enough,
-                            scale, start, tol, rel_tol);
+                            scale, start, tol, rel_tol, at);
 }
 
 }  // namespace hb

@@ -487,8 +487,9 @@ struct Solver {
   bool axis_curved = false;
 
   // The same along the unit vector n from time t0 (gap, rate and curvature bounds:
-  // contact/axis_gap.hpp).
-  double advance_on_axis(const Vec3& n, double t0, double hi) {
+  // contact/axis_gap.hpp); `at`: the search's support points of n at t0 (no gap evaluation
+  // there).
+  double advance_on_axis(const Vec3& n, double t0, double hi, const AxisSupport* at = nullptr) {
     using Gap = AxisGap<SA, SB>;
     Gap G(in.shape_a, A.motion, in.shape_b, B.motion, in.t_state, n, grow ? in.growth.s : 1.0,
           grow ? in.growth.rate : 0.0);
@@ -499,7 +500,13 @@ struct Solver {
     const double floor = G.is_curved() ? 1e-3 * in.eps_d : in.eps_d;
     const double noise = -1e-12 * L;
     double t = t0, slope = 0.0;
-    double g = G.value(t, slope, axis_ma, axis_mb);
+    double g;
+    if (at) {
+      axis_ma = at->ma, axis_mb = at->mb;
+      g = G.value(t, at->ma, at->mb, at->pa, at->pb, slope);
+    } else {
+      g = G.value(t, slope, axis_ma, axis_mb);
+    }
     ++out.axis_steps;
     for (int k = 0; k < 64; ++k) {
       const bool leaving = G.is_curved() && slope > 0.0 && g >= noise;
@@ -683,13 +690,15 @@ struct Solver {
         // a gap of K (hi - lo) already rules out any contact in the window
         const double reach = hi < kInf ? (grow ? rate_bound(lo, hi) : K) * (hi - lo) : kInf;
         double g0;
+        AxisSupport at;
         const Vec3 n = separating_axis(in.shape_a, A.motion, in.shape_b, B.motion, lo - in.t_state,
                                        o.axis_evals, g0, reach, grow ? A.scale_at(lo) : 1.0,
-                                       k > 0 ? &axis : nullptr, 1e-3 * in.eps_d, o.axis_rel_tol);
+                                       k > 0 ? &axis : nullptr, 1e-3 * in.eps_d, o.axis_rel_tol,
+                                       &at);
         if (!(n.squaredNorm() > 0.0)) break;
         axis = n;
         if (g0 >= reach) return;  // none
-        const double t = advance_on_axis(n, lo, hi);
+        const double t = advance_on_axis(n, lo, hi, &at);
         if (!(t < hi)) return;  // none
         if (!(t > lo)) break;
         lo = t;

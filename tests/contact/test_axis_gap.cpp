@@ -209,6 +209,53 @@ TEST(AxisGap, SuperquadricsUseTheFirstOrderBound) {
   EXPECT_LE(worst, 1.0 + 1e-6);
 }
 
+// The gap at the search's own time from the support points the search found (AxisSupport, the
+// first value of the contact-time solver's axis leaps) against the gap evaluated from scratch
+// (value(t): rotations and support points again): the same gap and rate on random pairs,
+// spherical and asymmetric tops, rigid and growing, ellipsoids (second order) and
+// superquadrics with exponent 4 (first order).
+TEST(AxisGap, SearchSupportPointsGiveTheSameGapAsAFreshEvaluation) {
+  Rng r(73);
+  const int n = scaled_count(1000, 0.1);
+  double worst_gap = 0.0, worst_rate = 0.0, worst_sq = 0.0;
+  for (int k = 0; k < n; ++k) {
+    const bool tops = k % 2 == 1, growing = k % 3 == 2;
+    const Pair p = random_pair(r, r.log_uni(1e-4, 2.0), tops);
+    const double s0 = growing ? r.uni(0.8, 1.2) : 1.0, sdot = growing ? r.uni(-0.1, 0.3) : 0.0;
+    const double tau = k % 4 == 0 ? 0.0 : r.uni(0.0, 0.3);
+    const Motion ma(p.sa), mb(p.sb);
+    double gap;
+    AxisSupport at;
+    const Vec3 axis = separating_axis(p.a, ma, p.b, mb, tau, 12, gap, kInf, s0 + sdot * tau,
+                                      nullptr, 0.0, 0.3, &at);
+    ASSERT_GT(axis.squaredNorm(), 0.0);
+    const AxisGap<Ellipsoid, Ellipsoid> g(p.a, ma, p.b, mb, 0.0, axis, s0, sdot);
+    double slope, slope_at;
+    Vec3 va, vb;
+    const double g_fresh = g.value(tau, slope, va, vb);
+    const double g_at = g.value(tau, at.ma, at.mb, at.pa, at.pb, slope_at);
+    const double L = std::max(p.a.bounding_radius(), p.b.bounding_radius());
+    worst_gap = std::max({worst_gap, std::abs(g_at - g_fresh) / L, std::abs(g_at - gap) / L});
+    worst_rate = std::max(worst_rate, std::abs(slope_at - slope) / g.Kn);
+    // flat faces (first order: the rate is -Kn either way)
+    const Superquadric qa{p.a.a, p.a.b, p.a.c, 4, 4, 4}, qb{p.b.a, p.b.b, p.b.c, 4, 4, 4};
+    double gq;
+    AxisSupport aq;
+    const Vec3 nq = separating_axis(qa, ma, qb, mb, tau, 12, gq, kInf, 1.0, nullptr, 0.0, 0.3, &aq);
+    const AxisGap<Superquadric, Superquadric> G(qa, ma, qb, mb, 0.0, nq);
+    double sq_fresh, sq_at;
+    const double q_fresh = G.value(tau, sq_fresh, va, vb);
+    const double q_at = G.value(tau, aq.ma, aq.mb, aq.pa, aq.pb, sq_at);
+    worst_sq = std::max({worst_sq, std::abs(q_at - q_fresh) / L, std::abs(q_at - gq) / L});
+    EXPECT_EQ(sq_at, sq_fresh);
+  }
+  std::printf("  %d pairs: max |g_at - g| / L %.2e, max |g'_at - g'| / Kn %.2e, superquadrics "
+              "max |g_at - g| / L %.2e\n", n, worst_gap, worst_rate, worst_sq);
+  EXPECT_LE(worst_gap, 1e-13);
+  EXPECT_LE(worst_rate, 1e-12);
+  EXPECT_LE(worst_sq, 1e-13);
+}
+
 // A superquadric with all exponents 2 is an ellipsoid: finite curvature radius, second-order
 // steps; its gap, rate and curvature bound equal the ellipsoid's on random axes.
 TEST(AxisGap, SuperquadricWithExponentsTwoIsCurvedLikeTheEllipsoid) {
