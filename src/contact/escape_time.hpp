@@ -112,14 +112,26 @@ struct BoxDistance {
     const double sc = scale_at(t);
     for (int k = 0; k < 3; ++k) {
       const Vec3 nb = Rn.col(k);
-      const double hm = shape.support(-nb), hp = shape.support(nb);
+      // A centrally symmetric shape has h(-n) = h(n) and p(-n) = -p(n) bit for bit: one
+      // support value (and point) per box axis instead of two, the same numbers. (h is taken
+      // from support(), not as n.p, so that the values with and without the rates stay equal
+      // bit for bit: first_root compares them.) Other shapes: both directions (the twin,
+      // tests/contact/test_escape_time.cpp).
+      double hm, hp;
+      Vec3 pm, pp;
+      if constexpr (CentrallySymmetric<S>) {
+        hp = hm = shape.support(nb);
+        if (dd) pp = R * shape.support_point(nb), pm = -pp;
+      } else {
+        hm = shape.support(-nb), hp = shape.support(nb);
+        if (dd) pm = R * shape.support_point(-nb), pp = R * shape.support_point(nb);
+      }
       d[2 * k] = lim[k] + x[k] - sc * hm;
       d[2 * k + 1] = lim[k] - x[k] - sc * hp;
       if (dd) {
         const Vec3 u = axes.col(k);
         const Vec3 wxu = w.cross(u);
         const double vn = st.v.dot(u);
-        const Vec3 pm = R * shape.support_point(-nb), pp = R * shape.support_point(nb);
         (*dd)[2 * k] = vn - sc * pm.dot(wxu) - sdot * hm;
         (*dd)[2 * k + 1] = -vn + sc * pp.dot(wxu) - sdot * hp;
       }

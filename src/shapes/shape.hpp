@@ -43,6 +43,12 @@ concept SupportShape = Shape<S> && requires(const S& s, const Vec3& n) {
   { s.support_hessian(n) } -> std::convertible_to<Mat3>;
 };
 
+// Shapes symmetric under x -> -x declare `static constexpr bool kCentrallySymmetric = true`:
+// then h(-n) = h(n) and p(-n) = -p(n), bit for bit (every shape of the engine is; the escape
+// times of neighbour-list boxes use it, contact/escape_time.hpp).
+template <class S>
+concept CentrallySymmetric = requires { requires S::kCentrallySymmetric; };
+
 // Ray-surface intersection for any shape: the root s > 0 of phi(s) = f(s u), |u| = 1, on the
 // bracket [inscribed_radius, bounding_radius] (phi is negative below and positive above).
 // Safeguarded Newton (bisection whenever a Newton step leaves the bracket).  Shapes with a

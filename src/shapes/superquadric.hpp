@@ -102,6 +102,8 @@ inline double log_root(const Vec3& k, const Vec3& v) {
 // treat them as read-only: build a new Superquadric to change a shape.
 struct Superquadric {
   static constexpr const char* kName = "superquadric";
+  // |x_i| only: h(-n) = h(n), p(-n) = -p(n) bit for bit (shapes/shape.hpp)
+  static constexpr bool kCentrallySymmetric = true;
   double a = 1.0, b = 1.0, c = 1.0;  // semi-axes along body x, y, z
   double n = 2.0, m = 2.0, p = 2.0;  // exponents (>= 2) of |x/a|, |y/b|, |z/c|
 

@@ -12,6 +12,7 @@
 
 #include "contact/escape_time.hpp"
 #include "geometry/random_pairs.hpp"
+#include "shapes/superquadric.hpp"
 
 namespace hb {
 namespace {
@@ -116,6 +117,74 @@ TEST(EscapeTime, RatesMatchFiniteDifferences) {
       EXPECT_LE(std::abs(dd[f]), D.rate_bound(f) * (1 + 1e-12));
     }
   }
+}
+
+// A shape that does not declare itself centrally symmetric (the same ellipsoid or
+// superquadric underneath): BoxDistance evaluates both directions of every box axis for it, the
+// general path, and the engine's shapes one support point per axis.
+template <class S>
+struct Undeclared : S {
+  explicit Undeclared(const S& s) : S(s) {}
+  static constexpr bool kCentrallySymmetric = false;
+};
+static_assert(CentrallySymmetric<Ellipsoid> && CentrallySymmetric<Sphere> &&
+              CentrallySymmetric<Superquadric>);
+static_assert(!CentrallySymmetric<Undeclared<Ellipsoid>>);
+
+// The symmetry itself, bit for bit: h(-n) = h(n), p(-n) = -p(n) for every shape of the engine.
+TEST(EscapeTime, EngineShapesAreCentrallySymmetricBitForBit) {
+  testing::Rng r(17);
+  const Superquadric q{1.0, 0.6, 0.4, 8.0, 3.0, 2.0}, q2{1.0, 0.5, 0.5, 2.0, 2.0, 2.0};
+  const Sphere sp{0.7};
+  for (int k = 0; k < 1000; ++k) {
+    const Ellipsoid e = r.ellipsoid(5.0);
+    const Vec3 n = r.ball(3.0);
+    EXPECT_EQ(e.support(-n), e.support(n));
+    EXPECT_EQ(e.support_point(-n), Vec3(-e.support_point(n)));
+    EXPECT_EQ(sp.support(-n), sp.support(n));
+    EXPECT_EQ(sp.support_point(-n), Vec3(-sp.support_point(n)));
+    for (const Superquadric& s : {q, q2}) {
+      EXPECT_EQ(s.support(-n), s.support(n));
+      EXPECT_EQ(s.support_point(-n), Vec3(-s.support_point(n)));
+    }
+  }
+}
+
+// The one-point-per-axis face distances and rates against the general path, on random flights
+// of ellipsoids and superquadrics (flat faces, exponents up to 8): equal bit for bit, and the
+// distances with and without the rates too (first_root relies on that).
+TEST(EscapeTime, SymmetricShapesGiveTheSameFaceDistancesAsTheGeneralPath) {
+  testing::Rng r(19);
+  double worst_d = 0.0, worst_dd = 0.0;
+  auto compare = [&](const auto& shape, const BodyState& s, const Obb& box, double t) {
+    using S = std::decay_t<decltype(shape)>;
+    const BoxDistance<S> fast(shape, s, 0.0, box, 0.01);
+    const Undeclared<S> plain_shape(shape);
+    const BoxDistance<Undeclared<S>> plain(plain_shape, s, 0.0, box, 0.01);
+    std::array<double, 6> d, dd, d2, dd2, d3;
+    fast.at(t, d, &dd);
+    plain.at(t, d2, &dd2);
+    fast.at(t, d3);
+    for (int f = 0; f < 6; ++f) {
+      EXPECT_EQ(d[f], d2[f]);   // the same numbers bit for bit
+      EXPECT_EQ(d3[f], d[f]);   // with and without the rates
+      EXPECT_EQ(dd[f], dd2[f]);
+      worst_d = std::max(worst_d, std::abs(d[f] - d2[f]));
+      worst_dd = std::max(worst_dd, std::abs(dd[f] - dd2[f]) / plain.rate_bound(f));
+    }
+  };
+  for (int k = 0; k < 500; ++k) {
+    const Ellipsoid e = r.ellipsoid(5.0);
+    const BodyState s{r.ball(1.0), r.quat(), 3.0 * r.unit(), r.log_uni(0.1, 30.0) * r.unit()};
+    const double t = r.uni(0.0, 1.0);
+    compare(e, s, box_around(e, s, 0.3), t);
+    const Superquadric q{e.a, e.b, e.c, r.uni(2.0, 8.0), r.uni(2.0, 8.0), r.uni(2.0, 8.0)};
+    compare(q, s, Obb{s.r, s.q.toRotationMatrix(), Vec3(q.half_extents().array() + 0.3)}, t);
+  }
+  std::printf("  1000 flights: max |d - d_general| %.2e, max |d' - d'_general| / K %.2e\n",
+              worst_d, worst_dd);
+  EXPECT_EQ(worst_d, 0.0);
+  EXPECT_EQ(worst_dd, 0.0);
 }
 
 // |d_f''| <= M_f (curvature_bound): second differences of d_f along random flights, with the
