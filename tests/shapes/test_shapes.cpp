@@ -98,7 +98,7 @@ TEST(Shapes, SphereDerivativesRaySupport) {
 }
 
 TEST(Shapes, EllipsoidDerivativesRaySupport) {
-  for (const Ellipsoid e : {Ellipsoid{2.0, 1.0, 1.0}, Ellipsoid{0.5, 1.0, 1.0},
+  for (const Ellipsoid& e : {Ellipsoid{2.0, 1.0, 1.0}, Ellipsoid{0.5, 1.0, 1.0},
                             Ellipsoid{0.3, 1.7, 4.0}, Ellipsoid{10.0, 1.0, 0.1}}) {
     check_derivatives(e, 200);
     check_ray(e, 200);
