@@ -191,7 +191,7 @@ struct ContactResult {
   int grazing_searches = 0;     // Brent minimisations
   int fallbacks = 0;            // NR rejected, bracket shrunk on the sign of d(t) instead
   int distance_fallbacks = 0;   // distance solves that needed a fallback stage
-  int axis_steps = 0;           // separating-axis steps (support-function evaluations pairs)
+  int axis_steps = 0;           // separating-axis gap values (the first after a search is its own)
   int ahead = 0;                // contacts found by Newton ahead of a sample (step 4')
   DistanceWarmStart warm;       // last distance solution (warm start for the next prediction)
 };
