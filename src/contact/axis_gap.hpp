@@ -19,7 +19,10 @@
 //     |d^2 h(m(t)) / dt^2| <= rho s^2 + L |w| s,
 // so |g_n''| <= M = sum over the bodies of s (rho s + L |w|). Shapes whose
 // max_curvature_radius() is finite (ellipsoids, spheres, superquadrics with all exponents 2) get
-// M; others (superquadrics with an exponent > 2: flat faces, rho unbounded) only K_n.
+// M; others (superquadrics with an exponent > 2: flat faces, rho unbounded) only K_n, and, for
+// rigid bodies, the affine bound (affine_bound below): the support functions evaluated at the
+// directions extrapolated to first order, m + s m', less a remainder L |m''| s^2 / 2 -- a
+// concave lower bound of g(t + s) that needs no radius of curvature.
 // Evaluation: R(t)^T n = R(t_state)^T rot(w, -|w| tau) n (Rodrigues on one vector, tau =
 // t - t_state): two sin/cos and two support functions per value.
 // Tops that are not spherical (W(t) varies; motion/motion.hpp): m' = -W x m still, so
@@ -95,6 +98,7 @@ class AxisGap {
       if (curved_)
         Mrigid_ = swa * swa * sa.max_curvature_radius() + La * mdd_a +
                   swb * swb * sb.max_curvature_radius() + Lb * mdd_b;
+    Q_ = La * mdd_a + Lb * mdd_b;
     bounds(s0);
     RaT_ = a.q.toRotationMatrix().transpose();
     RbT_ = b.q.toRotationMatrix().transpose();
@@ -116,9 +120,74 @@ class AxisGap {
 
   // g(t); slope = g'(t) for curved() pairs, -Kn otherwise; ma, mb the body-frame directions
   // (their support points are the extreme points along the axis).
-  double value(double t, double& slope, Vec3& ma, Vec3& mb) const {
+  // (Kept out of line: inlined into the solver's loops it costs the ellipsoid path ~1 %.)
+  [[gnu::noinline]] double value(double t, double& slope, Vec3& ma, Vec3& mb) const {
     const double tau = t - t_state_;
-    Vec3 Wa = Wa_, Wb = Wb_;  // body-frame angular velocities at t
+    Vec3 Wa, Wb;
+    directions(tau, ma, mb, Wa, Wb);
+    if (curved_)
+      return from_support(tau, ma, mb, sa_.support_point(ma), sb_.support_point(mb), Wa, Wb, slope);
+    slope = -Kn;
+    return n_.dot(dr_ + dv_ * tau) - scale_at(t) * (sa_.support(ma) + sb_.support(mb));
+  }
+  // g(t) and its exact rate g'(t) for every pair (curved or not), with the body-frame
+  // directions ma, mb and angular velocities Wa, Wb at t (what affine_bound needs).
+  double value_and_rate(double t, double& slope, Vec3& ma, Vec3& mb, Vec3& Wa, Vec3& Wb) const {
+    const double tau = t - t_state_;
+    directions(tau, ma, mb, Wa, Wb);
+    return from_support(tau, ma, mb, sa_.support_point(ma), sb_.support_point(mb), Wa, Wb, slope);
+  }
+  // The same from the search's support points at t (value(t, ma, mb, pa, pb, slope) below).
+  double value_and_rate(double t, const Vec3& ma, const Vec3& mb, const Vec3& pa, const Vec3& pb,
+                        double& slope, Vec3& Wa, Vec3& Wb) const {
+    const double tau = t - t_state_;
+    rates(tau, Wa, Wb);
+    return from_support(tau, ma, mb, pa, pb, Wa, Wb, slope);
+  }
+
+  // Rigid pairs (no growth: has_affine_bound()): a lower bound of g(t + s) for every s >= 0,
+  //     B(s) = n.(c(t) + dv s) - s0 [h_A(m_A + s m_A') + h_B(m_B + s m_B')] - s0 Q s^2 / 2,
+  // m = m(t), m' = m x W (W the body-frame angular velocity at t), Q = L_A |m_A''|max +
+  // L_B |m_B''|max. Derivation: m(t + s) = m + s m' + r(s) with |r| <= s^2 |m''|max / 2, and a
+  // support function is sublinear, h(u + r) <= h(u) + h(r) <= h(u) + L |r|. B is concave in s
+  // (linear minus convex functions of an affine argument minus a parabola) and B(0) = g(t), so
+  // B(s1) > 0 rules out any zero of g on [t, t + s1], and the zero of the chord from (0, g) to
+  // (s1, B(s1) < 0) lies before the first zero of B. Unlike the curvature bound M, Q needs no
+  // radius of curvature: flat faces (superquadrics with exponents > 2) get steps beyond first
+  // order. Two support functions per bound, of the non-unit directions m + s m'.
+  bool has_affine_bound() const { return sdot_ == 0.0; }
+  double affine_remainder() const { return s0_ * Q_; }  // the coefficient of s^2 / 2 in B
+  double affine_bound(double t, double s, const Vec3& ma, const Vec3& mb, const Vec3& Wa,
+                      const Vec3& Wb) const {
+    const double tau = t - t_state_;
+    const Vec3 ua = ma + s * ma.cross(Wa), ub = mb + s * mb.cross(Wb);
+    return n_.dot(dr_ + dv_ * (tau + s)) - s0_ * (sa_.support(ua) + sb_.support(ub) + 0.5 * Q_ * s * s);
+  }
+  double value(double t) const {
+    double s;
+    Vec3 ma, mb;
+    return value(t, s, ma, mb);
+  }
+  // The same from the body-frame directions ma, mb of the axis at time t and their support
+  // points pa, pb, found already (the end of separating_axis at that time: AxisSupport). Saves
+  // the rotations and the two support points of value(t). The gap is n.c - s (pa.ma + pb.mb)
+  // for every pair (exact support points: pa.ma is the support function).
+  double value(double t, const Vec3& ma, const Vec3& mb, const Vec3& pa, const Vec3& pb,
+               double& slope) const {
+    const double tau = t - t_state_;
+    if (!curved_) {
+      slope = -Kn;
+      return n_.dot(dr_ + dv_ * tau) - (s0_ + sdot_ * tau) * (pa.dot(ma) + pb.dot(mb));
+    }
+    Vec3 Wa, Wb;
+    rates(tau, Wa, Wb);
+    return from_support(tau, ma, mb, pa, pb, Wa, Wb, slope);
+  }
+
+ private:
+  // The body-frame directions ma = R_A^T n, mb = -R_B^T n and angular velocities at tau.
+  void directions(double tau, Vec3& ma, Vec3& mb, Vec3& Wa, Vec3& Wb) const {
+    Wa = Wa_, Wb = Wb_;
     if (ma_->spherical()) {
       ma = RaT_ * back(ka_, wa_, tau);
     } else {
@@ -137,37 +206,15 @@ class AxisGap {
       const Mat3 RT = q.toRotationMatrix().transpose();
       mb = -(RT * n_), Wb = RT * w;
     }
-    const double sc = s0_ + sdot_ * tau;
-    if (curved_)
-      return from_support(tau, ma, mb, sa_.support_point(ma), sb_.support_point(mb), Wa, Wb, slope);
-    slope = -Kn;
-    return n_.dot(dr_ + dv_ * tau) - sc * (sa_.support(ma) + sb_.support(mb));
   }
-  double value(double t) const {
-    double s;
-    Vec3 ma, mb;
-    return value(t, s, ma, mb);
-  }
-  // The same from the body-frame directions ma, mb of the axis at time t and their support
-  // points pa, pb, found already (the end of separating_axis at that time: AxisSupport). Saves
-  // the rotations and the two support points of value(t). The gap is n.c - s (pa.ma + pb.mb)
-  // for every pair (exact support points: pa.ma is the support function).
-  double value(double t, const Vec3& ma, const Vec3& mb, const Vec3& pa, const Vec3& pb,
-               double& slope) const {
-    const double tau = t - t_state_;
-    if (!curved_) {
-      slope = -Kn;
-      return n_.dot(dr_ + dv_ * tau) - (s0_ + sdot_ * tau) * (pa.dot(ma) + pb.dot(mb));
-    }
-    Vec3 Wa = Wa_, Wb = Wb_;
+  // The body-frame angular velocities alone (constant for spherical tops).
+  void rates(double tau, Vec3& Wa, Vec3& Wb) const {
+    Wa = Wa_, Wb = Wb_;
     Quat q;
     Vec3 w;
     if (!ma_->spherical()) ma_->pose(tau, q, w), Wa = q.conjugate() * w;
     if (!mb_->spherical()) mb_->pose(tau, q, w), Wb = q.conjugate() * w;
-    return from_support(tau, ma, mb, pa, pb, Wa, Wb, slope);
   }
-
- private:
   // g and g' (curved pairs) from the support points pa, pb along the body-frame directions
   // ma, mb, the body-frame angular velocities Wa, Wb at tau = t - t_state.
   double from_support(double tau, const Vec3& ma, const Vec3& mb, const Vec3& pa, const Vec3& pb,
@@ -191,7 +238,7 @@ class AxisGap {
   Vec3 n_, dr_, dv_;
   double t_state_, s0_, sdot_;
   bool curved_;
-  double wa_ = 0.0, wb_ = 0.0, ndv_ = 0.0, rot_ = 0.0, Lsum_ = 0.0, Mrigid_ = 0.0;
+  double wa_ = 0.0, wb_ = 0.0, ndv_ = 0.0, rot_ = 0.0, Lsum_ = 0.0, Mrigid_ = 0.0, Q_ = 0.0;
   Mat3 RaT_, RbT_;
   Vec3 Wa_, Wb_, ka_, kb_;
 };
