@@ -149,7 +149,7 @@ inline LatticeCheck fit_particle_number(RigidPoint& pt) {
 // Counters of a simulation at one moment; differences give the cost of a stretch of events.
 struct Tally {
   double cpu = 0, wall = 0, collisions = 0, neighbour_events = 0, stale = 0;
-  double predictions = 0, distance_evals = 0, distance_nr = 0, axis_steps = 0, hits = 0,
+  double predictions = 0, distance_evals = 0, distance_nr = 0, axis_steps = 0, axis_bounds = 0, hits = 0,
          hit_distance_evals = 0, grazing = 0, contact_fallbacks = 0, distance_fallbacks = 0,
          collision_distance_fallbacks = 0;
   Tally operator-(const Tally& o) const {
@@ -158,6 +158,7 @@ struct Tally {
     d.neighbour_events = neighbour_events - o.neighbour_events, d.stale = stale - o.stale;
     d.predictions = predictions - o.predictions, d.distance_evals = distance_evals - o.distance_evals;
     d.distance_nr = distance_nr - o.distance_nr, d.axis_steps = axis_steps - o.axis_steps;
+    d.axis_bounds = axis_bounds - o.axis_bounds;
     d.hits = hits - o.hits, d.hit_distance_evals = hit_distance_evals - o.hit_distance_evals;
     d.grazing = grazing - o.grazing, d.contact_fallbacks = contact_fallbacks - o.contact_fallbacks;
     d.distance_fallbacks = distance_fallbacks - o.distance_fallbacks;
@@ -167,7 +168,7 @@ struct Tally {
   Tally& operator+=(const Tally& o) {
     cpu += o.cpu, wall += o.wall, collisions += o.collisions, neighbour_events += o.neighbour_events;
     stale += o.stale, predictions += o.predictions, distance_evals += o.distance_evals;
-    distance_nr += o.distance_nr, axis_steps += o.axis_steps, hits += o.hits;
+    distance_nr += o.distance_nr, axis_steps += o.axis_steps, axis_bounds += o.axis_bounds, hits += o.hits;
     hit_distance_evals += o.hit_distance_evals, grazing += o.grazing;
     contact_fallbacks += o.contact_fallbacks, distance_fallbacks += o.distance_fallbacks;
     collision_distance_fallbacks += o.collision_distance_fallbacks;
@@ -193,6 +194,7 @@ Tally tally(const Sim& sim) {
     const hb::SolverStats& s = sim.model().stats;
     t.predictions = double(s.predictions), t.distance_evals = double(s.distance_evals);
     t.distance_nr = double(s.distance_nr_iterations), t.axis_steps = double(s.axis_steps);
+    t.axis_bounds = double(s.axis_bounds);
     t.hits = double(s.hits), t.hit_distance_evals = double(s.hit_distance_evals);
     t.grazing = double(s.grazing_searches), t.contact_fallbacks = double(s.fallbacks);
     t.distance_fallbacks = double(s.distance_fallbacks);
@@ -241,6 +243,7 @@ inline void put_costs(Json& j, const Tally& d) {
   j["distance_nr_iterations_per_eval"] = d.distance_nr / std::max(d.distance_evals, 1.0);
   j["axis_steps_per_collision"] = d.axis_steps / nc;
   j["axis_steps_per_prediction"] = d.axis_steps / np;
+  j["axis_bounds_per_collision"] = d.axis_bounds / nc;
   j["neighbour_events_per_collision"] = d.neighbour_events / nc;
   j["stale_per_collision"] = d.stale / nc;
   j["hits_per_collision"] = d.hits / nc;

@@ -61,7 +61,9 @@
 //  distance that costs two support functions instead of a distance solve, with the rate bound
 //  |g_n'| <= K_n <= K and, for shapes with bounded curvature, |g_n''| <= M.  It is advanced by
 //  conservative steps, the larger of g / K_n and the positive root of g + g' dt - M dt^2 / 2
-//  (lipschitz_step and curvature_step of contact/first_root.hpp):
+//  (lipschitz_step and curvature_step of contact/first_root.hpp); flat-faced rigid pairs (no
+//  M) take the larger of g / K_n and the step on the concave lower bound B(s) of
+//  AxisGap::affine_bound (Solver::affine_step: B at the tangent's zero, or the chord to it):
 //   a. before the first distance solve, along an axis found by Newton steps on the gap over
 //      directions (`separating_axis`: from the line of centres -- for rods, from the closest
 //      points of their core segments, geometry/segment.hpp -- until the gap rules the
@@ -174,6 +176,9 @@ struct ContactOptions {
   // gap evaluations per search, stopped once the gap is within axis_rel_tol of the distance.
   int axis_evals = 12;
   double axis_rel_tol = 0.3;
+  // Axis steps of flat-faced rigid pairs (no curvature bound) on the concave bound of
+  // AxisGap::affine_bound instead of first order only (false: first order, the slow twin).
+  bool affine_steps = true;
   DistanceOptions distance{};
 };
 
@@ -192,6 +197,7 @@ struct ContactResult {
   int fallbacks = 0;            // NR rejected, bracket shrunk on the sign of d(t) instead
   int distance_fallbacks = 0;   // distance solves that needed a fallback stage
   int axis_steps = 0;           // separating-axis gap values (the first after a search is its own)
+  int axis_bounds = 0;          // evaluations of the affine gap bound (flat-faced pairs)
   int ahead = 0;                // contacts found by Newton ahead of a sample (step 4')
   DistanceWarmStart warm;       // last distance solution (warm start for the next prediction)
 };
@@ -478,13 +484,20 @@ struct Solver {
     else return false;
   }
 
+  // Axis steps that converge on the gap's zero and leave a touching pair that separates:
+  // curved pairs, or flat-faced rigid pairs with affine steps.
+  static constexpr bool kMayBeFlat = kAxis && !(BoundedCurvature<SA> && BoundedCurvature<SB>);
+  bool second_order_axes() const {
+    return curved_axes() || (kMayBeFlat && o.affine_steps && !grow);
+  }
+
   // Separating-axis advancement from sample s (d >= eps_d, see the header): the time up to
   // which no contact is possible, >= hi if none in the window.
   double advance_on_axis(const Sample& s, double hi) { return advance_on_axis(s.res.normal, s.t, hi); }
 
   Vec3 axis_ma = Vec3::Zero(), axis_mb = Vec3::Zero();  // body-frame axes of the last gap
-  double axis_g = kInf, axis_slope = 0.0;  // the last gap and its rate (curved pairs)
-  bool axis_curved = false;
+  double axis_g = kInf, axis_slope = 0.0;  // the last gap and its rate (second-order pairs)
+  bool axis_second_order = false;  // curved or affine steps: axis_slope is the exact rate
 
   // The same along the unit vector n from time t0 (gap, rate and curvature bounds:
   // contact/axis_gap.hpp); `at`: the search's support points of n at t0 (no gap evaluation
@@ -493,6 +506,9 @@ struct Solver {
     using Gap = AxisGap<SA, SB>;
     Gap G(in.shape_a, A.motion, in.shape_b, B.motion, in.t_state, n, grow ? in.growth.s : 1.0,
           grow ? in.growth.rate : 0.0);
+    // Flat-faced pairs (not curved) of rigid bodies: steps on the affine bound instead.
+    if constexpr (kMayBeFlat)
+      if (o.affine_steps && !G.is_curved() && G.has_affine_bound()) return advance_affine(G, t0, hi, at);
     // Second-order steps converge on the gap's zero: follow it closer than eps_d. They also
     // leave a touching pair that separates (g ~ 0, g' > 0: just after its collision): the
     // parabola g + g' dt - M dt^2 / 2 stays positive up to (g' + q) / M. A gap negative at
@@ -532,8 +548,74 @@ struct Solver {
       g = G.value(t, slope, axis_ma, axis_mb);
       ++out.axis_steps;
     }
-    axis_g = g, axis_slope = slope, axis_curved = G.is_curved();
+    axis_g = g, axis_slope = slope, axis_second_order = G.is_curved();
     return t;
+  }
+
+  // advance_on_axis for flat-faced rigid pairs: the larger of the first-order step and the
+  // step on the concave bound of AxisGap::affine_bound (affine_step), which needs the exact
+  // rate and the angular velocities at each value. The steps converge on the gap's zero like
+  // second-order ones (the same floor, 1e-3 eps_d) and leave a touching pair that separates.
+  template <class Gap>
+  [[gnu::noinline]] double advance_affine(const Gap& G, double t0, double hi, const AxisSupport* at) {
+    const double floor = 1e-3 * in.eps_d;
+    const double noise = -1e-12 * L;
+    double t = t0, slope = 0.0;
+    Vec3 Wa, Wb;
+    double g;
+    if (at) {
+      axis_ma = at->ma, axis_mb = at->mb;
+      g = G.value_and_rate(t, at->ma, at->mb, at->pa, at->pb, slope, Wa, Wb);
+    } else {
+      g = G.value_and_rate(t, slope, axis_ma, axis_mb, Wa, Wb);
+    }
+    ++out.axis_steps;
+    for (int k = 0; k < 64; ++k) {
+      const bool leaving = slope > 0.0 && g >= noise;
+      if (!(g >= floor || leaving)) break;
+      double dt = lipschitz_step(g, 0.0, G.Kn);  // Kn = 0: the gap never changes, no contact
+      if (t + dt < hi) {
+        const double sa = affine_step(G, t, g, slope, hi - t, dt, Wa, Wb);
+        if (!(sa > 0.0) && g < floor) break;  // a leaving pair the bound cannot move: sampled
+        dt = std::max(dt, sa);
+      }
+      if (!(dt > 0.0)) break;
+      const double t1 = t + dt;
+      if (!(t1 < hi)) return hi;
+      t = t1;
+      g = G.value_and_rate(t, slope, axis_ma, axis_mb, Wa, Wb);
+      ++out.axis_steps;
+    }
+    axis_g = g, axis_slope = slope, axis_second_order = true;
+    return t;
+  }
+
+  // The step from gap g >= 0 (rate slope) at t that the concave lower bound B of
+  // AxisGap::affine_bound allows, at most `rest` (the rest of the window); dt1 the first-order
+  // step. Trial: where the tangent of g reaches zero (or the window's end; 16 dt1 when neither
+  // is finite). If B stays above the noise level there, the trial step is safe; otherwise the
+  // chord from (0, g) to the trial point reaches that level before B does (B concave), and
+  // that is the step. Near contact the step is Newton's with a quadratic correction: the gap
+  // falls quadratically instead of by the factor 1 - |g'| / K_n of a first-order step.
+  // A touching pair that separates (g at noise level, g' > 0: just after its collision) has no
+  // chord to follow: a second trial at half the root of the parabola through B(0), B'(0) = g'
+  // and the first trial, kept if B is above the noise level there.
+  template <class Gap>
+  double affine_step(const Gap& G, double t, double g, double slope, double rest, double dt1,
+                     const Vec3& Wa, const Vec3& Wb) {
+    double s = std::min(slope < 0.0 ? g / -slope : kInf, rest);
+    if (!(s < kInf)) s = 16.0 * std::max(dt1, in.eps_d / G.Kn);
+    const double b = G.affine_bound(t, s, axis_ma, axis_mb, Wa, Wb);
+    ++out.axis_bounds;
+    const double noise = 1e-12 * L;
+    if (b > noise) return s;
+    if (g > in.eps_d * 1e-3 || !(slope > 0.0)) return g > noise ? s * ((g - noise) / (g - b)) : 0.0;
+    const double C = 2.0 * (g + slope * s - b) / (s * s);  // >= 0 (B concave)
+    if (!(C > 0.0)) return 0.0;
+    const double s2 = 0.5 * (slope + std::sqrt(slope * slope + 2.0 * C * std::max(g, 0.0))) / C;
+    if (!(s2 > 0.0 && s2 < s)) return 0.0;
+    ++out.axis_bounds;
+    return G.affine_bound(t, s2, axis_ma, axis_mb, Wa, Wb) > noise ? s2 : 0.0;
   }
 
   void report_hit(double t, const Vec3& x, const Vec3& n) {
@@ -589,14 +671,14 @@ struct Solver {
     return true;
   }
 
-  // Step 4' from the end of the axis leaps (curved pairs, no growth): the gap g < eps_d of the
+  // Step 4' from the end of the axis leaps (curved or affine steps, no growth): the gap g < eps_d of the
   // last axis at lo, approaching (g' < 0), and no contact before lo. The Newton starts from
   // the midpoint of the support points along the axis, alpha from their gradients, at
   // lo + g / |g'|, kept to [lo, lo + eps_d / K] (the rate step from a distance below eps_d); the
   // root is accepted as in solve_ahead. Saves the distance solve at lo.
   bool solve_ahead_of_axis(double lo, double hi) {
     if constexpr (kAxis) {
-      if (grow || !axis_curved || !(axis_g >= 0.0 && axis_g < in.eps_d && axis_slope < 0.0))
+      if (grow || !axis_second_order || !(axis_g >= 0.0 && axis_g < in.eps_d && axis_slope < 0.0))
         return false;
       const double t1 = std::min(lo + in.eps_d / K, hi);
       const Pose pa = A.pose_at(lo), pb = B.pose_at(lo);
@@ -725,7 +807,7 @@ struct Solver {
     if (K == 0.0) return;  // no relative motion: the distance never changes
     while (s.t < hi) {
       if constexpr (kAxis) {
-        if (o.separating_axis && (s.d >= in.eps_d || (s.dd > 0.0 && curved_axes()))) {
+        if (o.separating_axis && (s.d >= in.eps_d || (s.dd > 0.0 && second_order_axes()))) {
           const double t = advance_on_axis(s, hi);
           if (!(t < hi)) break;
           if (t > s.t) {

@@ -22,6 +22,7 @@ namespace hb {
 struct Ellipsoid {
   static constexpr const char* kName = "ellipsoid";
   static constexpr bool kCentrallySymmetric = true;  // shapes/shape.hpp
+  static constexpr bool kBoundedCurvature = true;    // shapes/shape.hpp
   // The semi-axes: set them through the constructor (the squares and inverse squares the
   // solvers use at every evaluation are kept beside them; three divisions per f, grad or
   // Hessian otherwise). Read-only in practice: a shape is rebuilt, never edited.
@@ -75,6 +76,7 @@ struct Ellipsoid {
 struct Sphere {
   static constexpr const char* kName = "sphere";
   static constexpr bool kCentrallySymmetric = true;  // shapes/shape.hpp
+  static constexpr bool kBoundedCurvature = true;    // shapes/shape.hpp
   double radius = 1.0;
 
   double f(const Vec3& x) const { return x.squaredNorm() / (radius * radius) - 1.0; }

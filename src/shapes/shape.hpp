@@ -49,6 +49,13 @@ concept SupportShape = Shape<S> && requires(const S& s, const Vec3& n) {
 template <class S>
 concept CentrallySymmetric = requires { requires S::kCentrallySymmetric; };
 
+// Shapes whose max_curvature_radius() is finite for every valid instance (ellipsoids, spheres)
+// declare `static constexpr bool kBoundedCurvature = true`: the contact-time solver then
+// compiles only its second-order axis steps for their pairs, not the flat-face ones
+// (contact/contact_time.hpp, advance_affine).
+template <class S>
+concept BoundedCurvature = requires { requires S::kBoundedCurvature; };
+
 // Ray-surface intersection for any shape: the root s > 0 of phi(s) = f(s u), |u| = 1, on the
 // bracket [inscribed_radius, bounding_radius] (phi is negative below and positive above).
 // Safeguarded Newton (bisection whenever a Newton step leaves the bracket).  Shapes with a

@@ -30,6 +30,7 @@ struct SolverStats {
   std::uint64_t predictions = 0;       // contact-time solves
   std::uint64_t distance_evals = 0;    // distance solves inside them
   std::uint64_t axis_steps = 0;        // separating-axis gap evaluations inside them
+  std::uint64_t axis_bounds = 0;       // affine gap bounds (flat-faced pairs)
   std::uint64_t distance_nr_iterations = 0;
   std::uint64_t contact_nr_iterations = 0;
   std::uint64_t grazing_searches = 0;
@@ -44,6 +45,7 @@ struct SolverStats {
     ++predictions;
     distance_evals += r.distance_evals;
     axis_steps += r.axis_steps;
+    axis_bounds += r.axis_bounds;
     distance_nr_iterations += r.distance_nr_iterations;
     contact_nr_iterations += r.nr_iterations;
     grazing_searches += r.grazing_searches;
