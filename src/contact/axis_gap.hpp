@@ -215,7 +215,7 @@ class AxisGap {
     if (!ma_->spherical()) ma_->pose(tau, q, w), Wa = q.conjugate() * w;
     if (!mb_->spherical()) mb_->pose(tau, q, w), Wb = q.conjugate() * w;
   }
-  // g and g' (curved pairs) from the support points pa, pb along the body-frame directions
+  // g and its exact rate g' from the support points pa, pb along the body-frame directions
   // ma, mb, the body-frame angular velocities Wa, Wb at tau = t - t_state.
   double from_support(double tau, const Vec3& ma, const Vec3& mb, const Vec3& pa, const Vec3& pb,
                       const Vec3& Wa, const Vec3& Wb, double& slope) const {
