@@ -575,7 +575,7 @@ struct Solver {
       if (!(g >= floor || leaving)) break;
       double dt = lipschitz_step(g, 0.0, G.Kn);  // Kn = 0: the gap never changes, no contact
       if (t + dt < hi) {
-        const double sa = affine_step(G, t, g, slope, hi - t, dt, Wa, Wb);
+        const double sa = affine_step(G, t, g, slope, hi - t, dt, floor, Wa, Wb);
         if (!(sa > 0.0) && g < floor) break;  // a leaving pair the bound cannot move: sampled
         dt = std::max(dt, sa);
       }
@@ -592,24 +592,24 @@ struct Solver {
 
   // The step from gap g >= 0 (rate slope) at t that the concave lower bound B of
   // AxisGap::affine_bound allows, at most `rest` (the rest of the window); dt1 the first-order
-  // step. Trial: where the tangent of g reaches zero (or the window's end; 16 dt1 when neither
-  // is finite). If B stays above the noise level there, the trial step is safe; otherwise the
-  // chord from (0, g) to the trial point reaches that level before B does (B concave), and
-  // that is the step. Near contact the step is Newton's with a quadratic correction: the gap
+  // step, floor the gap below which the pair counts as touching. Trial: where the tangent of
+  // g reaches zero (or the window's end; 16 dt1 when neither is finite). If B stays above the
+  // noise level there, the trial step is safe; otherwise the chord from (0, g) to the trial
+  // point reaches that level before B does (B concave), and that is the step. Near contact the step is Newton's with a quadratic correction: the gap
   // falls quadratically instead of by the factor 1 - |g'| / K_n of a first-order step.
   // A touching pair that separates (g at noise level, g' > 0: just after its collision) has no
   // chord to follow: a second trial at half the root of the parabola through B(0), B'(0) = g'
   // and the first trial, kept if B is above the noise level there.
   template <class Gap>
   double affine_step(const Gap& G, double t, double g, double slope, double rest, double dt1,
-                     const Vec3& Wa, const Vec3& Wb) {
+                     double floor, const Vec3& Wa, const Vec3& Wb) {
     double s = std::min(slope < 0.0 ? g / -slope : kInf, rest);
     if (!(s < kInf)) s = 16.0 * std::max(dt1, in.eps_d / G.Kn);
     const double b = G.affine_bound(t, s, axis_ma, axis_mb, Wa, Wb);
     ++out.axis_bounds;
     const double noise = 1e-12 * L;
     if (b > noise) return s;
-    if (g > in.eps_d * 1e-3 || !(slope > 0.0)) return g > noise ? s * ((g - noise) / (g - b)) : 0.0;
+    if (g > floor || !(slope > 0.0)) return g > noise ? s * ((g - noise) / (g - b)) : 0.0;
     const double C = 2.0 * (g + slope * s - b) / (s * s);  // >= 0 (B concave)
     if (!(C > 0.0)) return 0.0;
     const double s2 = 0.5 * (slope + std::sqrt(slope * slope + 2.0 * C * std::max(g, 0.0))) / C;
