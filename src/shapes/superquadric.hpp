@@ -290,11 +290,47 @@ struct Superquadric {
     }
     return H - rx * rx.transpose() / (lambda * W);
   }
+  // (u^T H u, u^T H v, v^T H v) for H = support_hessian(d), given the support point x =
+  // support_point(d): no second root solve and no matrix (contact/axis_gap.hpp).  The multiplier
+  // comes from x itself: d_i x_i = lambda e_i t_i^e_i, so lambda = h / sum e_i t_i^e_i (h = d.x).
+  // One power per axis with e_i > 2, t_i^(e_i-2) (by squaring when e_i is an integer), gives both
+  // t_i^e_i and the diagonal's t_i^(2-e_i); the diagonal has the same cap as support_hessian,
+  // which the shape tests compare with.
+  Vec3 support_hessian_forms(const Vec3& d, const Vec3& x, const Vec3& u, const Vec3& v) const {
+    const Vec3 e = exponents(), ax = axes();
+    const double h = d.dot(x);
+    Vec3 t, te2, diag;
+    double sum_et = 0.0, W = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      t[i] = std::abs(x[i]) / ax[i];
+      te2[i] = two_[i] ? 1.0 : ie_[i] >= 0 ? int_power(t[i], ie_[i]) : std::pow(t[i], e[i] - 2.0);
+      const double te = te2[i] * t[i] * t[i];  // t_i^e_i
+      sum_et += e[i] * te;
+      W += q_[i] * te;
+    }
+    if (!(h > 0.0) || !(sum_et > 0.0)) return Vec3::Zero();
+    const double lambda = h / sum_et, cap = 1e12 * h / d.squaredNorm();
+    for (int i = 0; i < 3; ++i)
+      diag[i] = std::min(ax[i] * ax[i] * inv_em1_[i] / (e[i] * lambda * te2[i]), cap);
+    const Vec3 rx = x.cwiseProduct(inv_em1_);
+    const double ru = rx.dot(u), rv = rx.dot(v), lW = lambda * W;
+    const Vec3 Du = diag.cwiseProduct(u);
+    return Vec3(u.dot(Du) - ru * ru / lW, v.dot(Du) - ru * rv / lW,
+                v.dot(diag.cwiseProduct(v)) - rv * rv / lW);
+  }
 
  private:
   double bounding_radius_ = 0.0, q_max_ = 2.0;
   Vec3 q_, inv_em1_, a_over_e_;  // e_i/(e_i-1), 1/(e_i-1), a_i/e_i
   bool two_[3] = {true, true, true};  // e_i == 2
+  int ie_[3] = {0, 0, 0};             // e_i - 2 when it is an integer <= 62, else -1
+  // t^k for 0 <= k <= 62 by repeated squaring (at most 11 multiplications, no pow)
+  static double int_power(double t, int k) {
+    double r = 1.0;
+    for (; k > 0; k >>= 1, t *= t)
+      if (k & 1) r *= t;
+    return r;
+  }
   bool equal_q_ = true;
   void cache() {
     const Vec3 e = exponents(), ax = axes();
@@ -303,6 +339,7 @@ struct Superquadric {
       inv_em1_[i] = 1.0 / (e[i] - 1.0);
       a_over_e_[i] = ax[i] / e[i];
       two_[i] = e[i] == 2.0;
+      ie_[i] = e[i] == std::floor(e[i]) && e[i] <= 64.0 ? static_cast<int>(e[i]) - 2 : -1;
     }
     q_max_ = q_.maxCoeff();
     equal_q_ = q_[0] == q_[1] && q_[1] == q_[2];

@@ -249,6 +249,31 @@ TEST(Superquadric, SupportFunction) {
   std::printf("  support: max |F(x)| %.2e, max 1 - cos(normal, d) %.2e\n", worst_f, worst_dot);
 }
 
+// The closed form of the support Hessian's quadratic forms (multiplier from the support point,
+// powers by squaring for integer exponents) against the matrix support_hessian: random shapes
+// with integer and non-integer exponents up to 40, directions in general position, next to a
+// coordinate plane (|d_i| down to 1e-12 |d|, where t_i^(2-e_i) is huge) and on one (the cap).
+TEST(Superquadric, SupportHessianFormsMatchTheSupportHessian) {
+  Rng r(108);
+  double worst = 0;
+  for (int k = 0; k < scaled_count(400, 0.1); ++k) {
+    const Superquadric s = random_sq(r, k % 2 ? 40.0 : 12.0);
+    for (int j = 0; j < 10; ++j) {
+      Vec3 d = r.unit() * r.log_uni(0.1, 10.0);
+      if (j == 1) d[k % 3] = 0.0;
+      if (j == 2) d[k % 3] *= r.log_uni(1e-12, 1e-3);
+      const Vec3 x = s.support_point(d);
+      const Vec3 u = r.unit(), v = r.unit();
+      const Mat3 H = s.support_hessian(d);
+      const Vec3 want(u.dot(H * u), v.dot(H * u), v.dot(H * v));
+      const double err = (s.support_hessian_forms(d, x, u, v) - want).norm() / H.norm();
+      worst = std::max(worst, err);
+      EXPECT_LE(err, 1e-12) << s.n << " " << s.m << " " << s.p << " j=" << j;
+    }
+  }
+  std::printf("  support Hessian forms vs matrix: max error %.2e of |H|\n", worst);
+}
+
 TEST(Superquadric, AllExponentsTwoIsTheEllipsoid) {
   Rng r(107);
   for (int k = 0; k < scaled_count(100, 0.2); ++k) {
