@@ -274,6 +274,42 @@ TEST(Superquadric, SupportHessianFormsMatchTheSupportHessian) {
   std::printf("  support Hessian forms vs matrix: max error %.2e of |H|\n", worst);
 }
 
+// (2, 2, p) bodies with integer p take their own support-point solver (a polynomial in t_p,
+// no power per iteration): against the long-double bisection for every p in 3..64, the flat
+// axis on x, y or z, directions in general position, near the flat axis (K down to 1e-24) and
+// near its plane (K up to 1e24, and d_p = 0, which takes the general solver).
+TEST(Superquadric, FlatAxisSupportPointMatchesBisection) {
+  Rng r(109);
+  double worst_x = 0, worst_f = 0, worst_par = 0;
+  for (int p = 3; p <= 64; ++p) {
+    for (int k = 0; k < 3; ++k) {
+      Vec3 ax(r.log_uni(0.2, 2.0), r.log_uni(0.2, 2.0), r.log_uni(0.2, 2.0)), e(2, 2, 2);
+      e[k] = p;
+      const Superquadric s{ax[0], ax[1], ax[2], e[0], e[1], e[2]};
+      const ref::SlowSuperquadric slow{s.a, s.b, s.c, s.n, s.m, s.p};
+      const double L = s.bounding_radius();
+      for (int j = 0; j < 12; ++j) {
+        Vec3 d = r.unit() * r.log_uni(0.1, 10.0);
+        if (j % 4 == 1) d[k] *= r.log_uni(1e-12, 1e-2);           // near the plane of axis k
+        if (j % 4 == 2) d[(k + 1) % 3] *= r.log_uni(1e-12, 1e-2),  // near axis k
+                        d[(k + 2) % 3] *= r.log_uni(1e-12, 1e-2);
+        if (j == 3) d[k] = 0.0;
+        const Vec3 x = s.support_point(d);
+        worst_x = std::max(worst_x, (x - slow.support_point(d)).norm() / L);
+        worst_f = std::max(worst_f, std::abs(s.f(x)));
+        EXPECT_LE((x - slow.support_point(d)).norm(), 1e-12 * L) << p << " " << k << " " << j;
+        EXPECT_NEAR(s.f(x), 0.0, 1e-13);
+        if (j == 3) continue;  // the normal is not defined at the flat face's rim when d_k = 0
+        const double par = s.grad(x).normalized().dot(d.normalized());
+        worst_par = std::max(worst_par, 1 - par);
+        EXPECT_GT(par, 1.0 - 1e-13) << p << " " << k << " " << j;
+      }
+    }
+  }
+  std::printf("  (2, 2, p) support point: max |x - bisection| %.2e L, |F(x)| %.2e, "
+              "1 - cos(normal, d) %.2e\n", worst_x, worst_f, worst_par);
+}
+
 TEST(Superquadric, AllExponentsTwoIsTheEllipsoid) {
   Rng r(107);
   for (int k = 0; k < scaled_count(100, 0.2); ++k) {
