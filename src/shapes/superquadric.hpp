@@ -21,7 +21,7 @@
 // point with x_i = 0 and e_i > 2 the i-th diagonal entry is exactly 0: the surface has zero
 // curvature there (the flat face centres of a high-exponent body), a genuine property of the
 // shape that every f with this zero set shares in its tangential Hessian.  Powers are taken
-// with pow() when S lies in [1e-250, 1e250]; outside (only far from the surface or within
+// with pow() (by squaring for an integer exponent) when S lies in [1e-250, 1e250]; outside (only far from the surface or within
 // ~1e-250^(1/e) of the centre) the same formulas are evaluated from logarithms, so nothing
 // overflows or underflows.  At the centre itself F = -1 and grad, hess are returned as 0
 // (F is not differentiable there when the exponents differ; no solver evaluates it there).
@@ -137,7 +137,10 @@ struct Superquadric {
     Vec3 w;
     double S = 0.0;
     for (int i = 0; i < 3; ++i) {
-      P.d2[i] = two_[i] ? 1.0 : std::pow(P.t[i], e[i] - 2.0);  // t^0 = 1 for e_i = 2
+      // t^0 = 1 for e_i = 2; integer exponents by squaring
+      P.d2[i] = two_[i]      ? 1.0
+                : ie_[i] > 0 ? int_power(P.t[i], ie_[i])
+                             : std::pow(P.t[i], e[i] - 2.0);
       P.d1[i] = P.d2[i] * P.t[i];
       w[i] = P.d1[i] * P.t[i];
       S += w[i];
