@@ -21,9 +21,9 @@
 // point with x_i = 0 and e_i > 2 the i-th diagonal entry is exactly 0: the surface has zero
 // curvature there (the flat face centres of a high-exponent body), a genuine property of the
 // shape that every f with this zero set shares in its tangential Hessian.  Powers are taken
-// with pow() (by squaring for an integer exponent) when S lies in [1e-250, 1e250]; outside (only far from the surface or within
-// ~1e-250^(1/e) of the centre) the same formulas are evaluated from logarithms, so nothing
-// overflows or underflows.  At the centre itself F = -1 and grad, hess are returned as 0
+// with pow() (by squaring for an integer exponent) when S lies in [1e-250, 1e250]; outside
+// (only far from the surface or within ~1e-250^(1/e) of the centre) the same formulas are
+// evaluated from logarithms, so nothing overflows or underflows.  At the centre itself F = -1 and grad, hess are returned as 0
 // (F is not differentiable there when the exponents differ; no solver evaluates it there).
 //
 // Support function (SupportShape).  max n.x over the body: the Lagrange condition
@@ -137,10 +137,7 @@ struct Superquadric {
     Vec3 w;
     double S = 0.0;
     for (int i = 0; i < 3; ++i) {
-      // t^0 = 1 for e_i = 2; integer exponents by squaring
-      P.d2[i] = two_[i]      ? 1.0
-                : ie_[i] > 0 ? int_power(P.t[i], ie_[i])
-                             : std::pow(P.t[i], e[i] - 2.0);
+      P.d2[i] = power_e_minus_2(P.t[i], i);
       P.d1[i] = P.d2[i] * P.t[i];
       w[i] = P.d1[i] * P.t[i];
       S += w[i];
@@ -306,7 +303,7 @@ struct Superquadric {
     double sum_et = 0.0, W = 0.0;
     for (int i = 0; i < 3; ++i) {
       t[i] = std::abs(x[i]) / ax[i];
-      te2[i] = two_[i] ? 1.0 : ie_[i] >= 0 ? int_power(t[i], ie_[i]) : std::pow(t[i], e[i] - 2.0);
+      te2[i] = power_e_minus_2(t[i], i);
       const double te = te2[i] * t[i] * t[i];  // t_i^e_i
       sum_et += e[i] * te;
       W += q_[i] * te;
@@ -330,6 +327,7 @@ struct Superquadric {
   int flat_axis_ = -1;  // (2, 2, p) with integer p in [3, 64]: the axis k of p, else -1
   double inv_2p_2_ = 0.0;  // 1 / (2p - 2)
   float inv_2p_2f_ = 0.0f;
+  bool equal_q_ = true;
   // t^k for 0 <= k <= 62 by repeated squaring (at most 11 multiplications, no pow)
   static double int_power(double t, int k) {
     double r = 1.0;
@@ -337,7 +335,11 @@ struct Superquadric {
       if (k & 1) r *= t;
     return r;
   }
-  bool equal_q_ = true;
+  // t^(e_i - 2): 1 for e_i = 2, by squaring for an integer e_i, else pow
+  double power_e_minus_2(double t, int i) const {
+    if (two_[i]) return 1.0;
+    return ie_[i] > 0 ? int_power(t, ie_[i]) : std::pow(t, exponents()[i] - 2.0);
+  }
   void cache() {
     const Vec3 e = exponents(), ax = axes();
     for (int i = 0; i < 3; ++i) {
