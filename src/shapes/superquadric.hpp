@@ -21,7 +21,8 @@
 // point with x_i = 0 and e_i > 2 the i-th diagonal entry is exactly 0: the surface has zero
 // curvature there (the flat face centres of a high-exponent body), a genuine property of the
 // shape that every f with this zero set shares in its tangential Hessian.  Powers are taken
-// with pow() (by squaring for an integer exponent) when S lies in [1e-250, 1e250]; outside
+// with pow() (by squaring for an integer exponent; rho = S^(1/E) as nested square roots when E
+// is a power of two) when S lies in [1e-250, 1e250]; outside
 // (only far from the surface or within ~1e-250^(1/e) of the centre) the same formulas are
 // evaluated from logarithms, so nothing overflows or underflows.  At the centre itself F = -1 and grad, hess are returned as 0
 // (F is not differentiable there when the exponents differ; no solver evaluates it there).
@@ -145,7 +146,7 @@ struct Superquadric {
       S += w[i];
     }
     if (S >= 1e-250 && S <= 1e250) {
-      P.rho = std::pow(S, 1.0 / E);
+      P.rho = rho_sqrts_ >= 0 ? nested_sqrt(S, rho_sqrts_) : std::pow(S, 1.0 / E);
       const double k = P.rho / S;
       P.d1 *= k;
       P.d2 *= k;
@@ -327,7 +328,8 @@ struct Superquadric {
   bool two_[3] = {true, true, true};  // e_i == 2
   int ie_[3] = {0, 0, 0};             // e_i - 2 when it is an integer <= 62, else -1
   int flat_axis_ = -1;  // (2, 2, p) with integer p in [3, 64]: the axis k of p, else -1
-  int flat_i_ = 0, flat_j_ = 0;  // the other two axes, k + 1 and k + 2 (mod 3)
+  int flat_i_ = 0, flat_j_ = 0;
+  int rho_sqrts_ = -1;  // k when e_max = 2^k (k <= 6), else -1  // the other two axes, k + 1 and k + 2 (mod 3)
   double inv_2p_2_ = 0.0;  // 1 / (2p - 2)
   // flat_support_point for this p (unrolled powers for p <= 16), or null: not (2, 2, p)
   using FlatSolver = bool (Superquadric::*)(const Vec3&, const Vec3&, Vec3&, double&) const;
@@ -339,6 +341,11 @@ struct Superquadric {
     for (; k > 0; k >>= 1, t *= t)
       if (k & 1) r *= t;
     return r;
+  }
+  // S^(1/2^k) as k square roots (E = 2^k: rho = S^(1/E) of powers() without pow)
+  static double nested_sqrt(double S, int k) {
+    for (; k > 0; --k) S = std::sqrt(S);
+    return S;
   }
   // t^(e_i - 2): 1 for e_i = 2, by squaring for an integer e_i, else pow
   double power_e_minus_2(double t, int i) const {
@@ -355,6 +362,9 @@ struct Superquadric {
       ie_[i] = e[i] == std::floor(e[i]) && e[i] <= 64.0 ? static_cast<int>(e[i]) - 2 : -1;
     }
     q_max_ = q_.maxCoeff();
+    rho_sqrts_ = -1;
+    for (int k = 1; k <= 6; ++k)
+      if (e_max() == double(1 << k)) rho_sqrts_ = k;
     flat_axis_ = -1;
     for (int k = 0; k < 3; ++k)
       if (ie_[k] >= 1 && two_[(k + 1) % 3] && two_[(k + 2) % 3]) flat_axis_ = k;
