@@ -273,8 +273,9 @@ Vec3 support_hessian_forms(const S& s, const Vec3& m, const Vec3& p, const Vec3&
 // the system definite where G < 0 or a radius of curvature vanishes). For elongated bodies the
 // radii differ by (a/b)^2 between directions, which is why plain gradient ascent needs many
 // steps there. Stops once the gap reaches `enough`, once |sep| - G <= max(tol, rel_tol G) (the
-// gap is within that of the distance), or after `iterations` evaluations of G (each two support
-// points). The search runs in A's body frame (two matrix-vector products per evaluation
+// gap is within that of the distance), for flat-faced pairs (a curvature radius unbounded) also
+// once the Newton model's gain is below rel_tol G, or after `iterations` evaluations of G (each
+// two support points). The search runs in A's body frame (two matrix-vector products per evaluation
 // instead of four). The same Newton step, in the relative frame and run to convergence, is the
 // distance solver's support stage (geometry/distance.hpp, support_maximum);
 // returns the best axis and its gap in `gap`; `scale` scales both shapes (growth). Zero vector
@@ -302,6 +303,7 @@ Vec3 separating_axis_at(const SA& sa, const Quat& rot_a, const SB& sb, const Qua
   const Mat3 Rab = (rot_a_inv * rot_b).toRotationMatrix();
   const Vec3 c = rot_a_inv * c_lab;
   const double l = 1e-3 * scale * std::min(sa.inscribed_radius(), sb.inscribed_radius());
+  const bool flat = !AxisGap<SA, SB>::curved(sa, sb);
   // B's body-frame direction and the support points of the last accepted evaluation
   Vec3 mb, pa, pb;
   auto eval = [&](const Vec3& n, Vec3& sep, Vec3& ub, Vec3& qa, Vec3& qb) {
@@ -354,6 +356,10 @@ Vec3 separating_axis_at(const SA& sa, const Quat& rot_a, const SB& sb, const Qua
       const double k = 1.0 / (shift + scale * (sa.bounding_radius() + sb.bounding_radius()));
       d1 = k * g1, d2 = k * g2;
     }
+    // Flat-faced pairs: |sep| joins support points that slide far apart across facing faces, a
+    // loose bound of the distance; stop also once the Newton model's own gain g.delta / 2 (the
+    // rise of the quadratic model to its maximum) is within rel_tol of the gap.
+    if (flat && gap > 0.0 && 0.5 * (g1 * d1 + g2 * d2) <= rel_tol * gap) break;
     Vec3 delta = d1 * e1 + d2 * e2;
     if (delta.norm() > 0.5) delta *= 0.5 / delta.norm();
     bool moved = false;
