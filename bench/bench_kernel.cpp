@@ -4,6 +4,9 @@
 // uses the analytic sphere distance inside the generic contact solver.
 // Counters: NR iterations per call (distance), distance evaluations and contact-NR iterations
 // per call (contact time).  Fixed seeds; pairs are generated once, outside the timed loop.
+// Support points of superquadrics (2, 2, p), semi-axes (1, 0.5, 0.5), along 4096 directions
+// uniform on the sphere: p = 2 (closed form), 8 (the (2, 2, p) solver with unrolled powers),
+// 20 (the same solver, powers by a loop) and (3, 3, 8) (the general solver).
 #include <benchmark/benchmark.h>
 
 #include <random>
@@ -12,6 +15,7 @@
 #include "contact/contact_time.hpp"
 #include "geometry/distance.hpp"
 #include "shapes/ellipsoid.hpp"
+#include "shapes/superquadric.hpp"
 
 namespace {
 
@@ -115,6 +119,17 @@ void contact_bench(benchmark::State& state, const S& s) {
   state.counters["hit_fraction"] = double(hits) / calls;
 }
 
+void support_bench(benchmark::State& state, const Superquadric& s) {
+  Gen g;
+  std::vector<Vec3> dirs(4096);
+  for (Vec3& d : dirs) d = g.unit();
+  size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(s.support_point(dirs[i]));
+    i = (i + 1) & 4095;
+  }
+}
+
 const Sphere kSphere{0.5};
 const Ellipsoid kProlate{1.0, 0.5, 0.5};  // X0 = 2 (symmetry axis along x)
 const Ellipsoid kOblate{0.25, 0.5, 0.5};  // X0 = 0.5
@@ -135,6 +150,10 @@ void BM_DistanceEllipsoidX05Warm(benchmark::State& s) { distance_bench(s, kOblat
 void BM_ContactTimeSphere(benchmark::State& s) { contact_bench(s, kSphere); }
 void BM_ContactTimeEllipsoidX2(benchmark::State& s) { contact_bench(s, kProlate); }
 void BM_ContactTimeEllipsoidX05(benchmark::State& s) { contact_bench(s, kOblate); }
+void BM_SupportSuperquadricP2(benchmark::State& s) { support_bench(s, {1.0, 0.5, 0.5, 2, 2, 2}); }
+void BM_SupportSuperquadricP8(benchmark::State& s) { support_bench(s, {1.0, 0.5, 0.5, 2, 2, 8}); }
+void BM_SupportSuperquadricP20(benchmark::State& s) { support_bench(s, {1.0, 0.5, 0.5, 2, 2, 20}); }
+void BM_SupportSuperquadric338(benchmark::State& s) { support_bench(s, {1.0, 0.5, 0.5, 3, 3, 8}); }
 
 BENCHMARK(BM_DistanceSphereAnalytic);
 BENCHMARK(BM_DistanceSphereGenericCold);
@@ -148,6 +167,10 @@ BENCHMARK(BM_DistanceEllipsoidX05Warm);
 BENCHMARK(BM_ContactTimeSphere);
 BENCHMARK(BM_ContactTimeEllipsoidX2);
 BENCHMARK(BM_ContactTimeEllipsoidX05);
+BENCHMARK(BM_SupportSuperquadricP2);
+BENCHMARK(BM_SupportSuperquadricP8);
+BENCHMARK(BM_SupportSuperquadricP20);
+BENCHMARK(BM_SupportSuperquadric338);
 
 }  // namespace
 
