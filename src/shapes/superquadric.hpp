@@ -22,10 +22,10 @@
 // curvature there (the flat face centres of a high-exponent body), a genuine property of the
 // shape that every f with this zero set shares in its tangential Hessian.  Powers are taken
 // with pow() (by squaring for an integer exponent; rho = S^(1/E) as nested square roots when E
-// is a power of two) when S lies in [1e-250, 1e250]; outside
-// (only far from the surface or within ~1e-250^(1/e) of the centre) the same formulas are
-// evaluated from logarithms, so nothing overflows or underflows.  At the centre itself F = -1 and grad, hess are returned as 0
-// (F is not differentiable there when the exponents differ; no solver evaluates it there).
+// is a power of two) when S lies in [1e-250, 1e250]; outside (only far from the surface or
+// within ~1e-250^(1/e) of the centre) the same formulas are evaluated from logarithms, so
+// nothing overflows or underflows.  At the centre itself F = -1 and grad, hess are returned as
+// 0 (F is not differentiable there when the exponents differ; no solver evaluates it there).
 //
 // Support function (SupportShape).  max n.x over the body: the Lagrange condition
 // n_i = lambda e_i t_i^(e_i-1) sgn(x_i) / a_i gives t_i = (c_i / lambda)^(1/(e_i-1)),
@@ -328,8 +328,8 @@ struct Superquadric {
   bool two_[3] = {true, true, true};  // e_i == 2
   int ie_[3] = {0, 0, 0};             // e_i - 2 when it is an integer <= 62, else -1
   int flat_axis_ = -1;  // (2, 2, p) with integer p in [3, 64]: the axis k of p, else -1
-  int flat_i_ = 0, flat_j_ = 0;
-  int rho_sqrts_ = -1;  // k when e_max = 2^k (k <= 6), else -1  // the other two axes, k + 1 and k + 2 (mod 3)
+  int flat_i_ = 0, flat_j_ = 0;  // the other two axes, k + 1 and k + 2 (mod 3)
+  int rho_sqrts_ = -1;            // k when e_max = 2^k (k <= 6), else -1
   double inv_2p_2_ = 0.0;  // 1 / (2p - 2)
   // flat_support_point for this p (unrolled powers for p <= 16), or null: not (2, 2, p)
   using FlatSolver = bool (Superquadric::*)(const Vec3&, const Vec3&, Vec3&, double&) const;
