@@ -19,7 +19,8 @@
 //    sphere leaving its cage (closed form, below); it then takes a new cage at its position,
 //    leaves its old neighbours' lists and joins those of its new ones (found through a grid of
 //    cage centres with cells of side >= sigma + s; a centre changes cell only there, so there
-//    are no cell-crossing events).
+//    are no cell-crossing events).  Each cell is a block of slots of one size for all cells
+//    (8 to start with; one more whenever a cell overflows), read as an array.
 //  * Early rejection before any square root.  For an approaching pair (b = r.v < 0) outside
 //    contact (c = r^2 - sigma^2 >= 0) the first root t = c / (sqrt(b^2 - a c) - b) satisfies
 //    t >= c / (-2 b) (sqrt(b^2 - a c) <= -b), so a pair with c >= -2 b t_best cannot beat the
@@ -65,9 +66,12 @@ class SphereEngine {
   };
 
   // Spheres of diameter sigma at the state's positions and velocities (all at s.t[i]); shell s:
-  // the cage diameter (neighbour lists reach sigma + s).
-  SphereEngine(const Box& box, const State& s, double sigma, double shell, double now = 0.0)
-      : L_(box.L), hL_(0.5 * box.L), sigma_(sigma), shell_(shell), now_(now) {
+  // the cage diameter (neighbour lists reach sigma + s).  cell_capacity: the cage-centre slots
+  // per grid cell to start with (they grow by one whenever a cell overflows; tests start at 1).
+  SphereEngine(const Box& box, const State& s, double sigma, double shell, double now = 0.0,
+               std::uint32_t cell_capacity = 8)
+      : L_(box.L), hL_(0.5 * box.L), sigma_(sigma), shell_(shell), now_(now),
+        cap_(std::max<std::uint32_t>(1, cell_capacity)) {
     if (!box.fully_periodic()) throw std::invalid_argument("SphereEngine: the box must be periodic");
     if (!(shell > 0.0)) throw std::invalid_argument("SphereEngine: the shell must be positive");
     const std::size_t n = s.size();
@@ -91,14 +95,8 @@ class SphereEngine {
         throw std::invalid_argument("SphereEngine: the box is smaller than 3 cells of sigma + shell");
       cell_len_[k] = L_[k] / ncell_[k];
     }
-    head_.assign(std::size_t(ncell_[0]) * ncell_[1] * ncell_[2], kNone);
-    next_.assign(n, kNone);
-    for (std::uint32_t i = 0; i < n; ++i) {
-      cage_[i] = Vec3(p_[i].x, p_[i].y, p_[i].z);
-      const std::uint32_t c = cell_of(cage_[i]);
-      next_[i] = head_[c];
-      head_[c] = i;
-    }
+    for (std::uint32_t i = 0; i < n; ++i) cage_[i] = Vec3(p_[i].x, p_[i].y, p_[i].z);
+    rebuild_cells();
     for (std::uint32_t i = 0; i < n; ++i) fill_list(i, /*only_higher=*/true);
     const std::uint32_t lists = std::max<std::uint32_t>(16, std::uint32_t(n / 4));  // 2 B/sphere
     q_.reset(static_cast<std::uint32_t>(n), 1.0, lists, now);
@@ -124,6 +122,9 @@ class SphereEngine {
   std::uint64_t collisions() const { return collisions_; }
   std::uint64_t cage_exits() const { return cages_; }
   std::uint64_t stale_events() const { return stale_; }
+  // Cage-centre slots per grid cell now, and how often a cell overflowed during the run.
+  std::uint32_t cell_capacity() const { return cap_; }
+  std::uint64_t cell_growths() const { return growths_; }
   std::size_t size() const { return p_.size(); }
 
   // Process the next event.
@@ -184,12 +185,11 @@ class SphereEngine {
   std::size_t bytes_per_sphere() const {
     const std::size_t b = p_.capacity() * sizeof(Sph) + cage_.capacity() * sizeof(Vec3) +
                           nb_.capacity() * sizeof(std::uint32_t) +
-                          q_.bytes() + (head_.capacity() + next_.capacity()) * sizeof(std::uint32_t);
+                          q_.bytes() + slot_.capacity() * sizeof(std::uint32_t) + used_.capacity();
     return p_.empty() ? 0 : (b + p_.size() - 1) / p_.size();
   }
 
  private:
-  static constexpr std::uint32_t kNone = 0xffffffffu;
   struct alignas(64) Sph {
     double x, y, z, t;     // position at the own clock t
     double vx, vy, vz;
@@ -244,12 +244,16 @@ class SphereEngine {
   }
 
   // List every j whose cage centre is within sigma + s of i's (both ways); with only_higher,
-  // only j > i (the initial fill, which visits every pair once).
+  // only j > i (the initial fill, which visits every pair once).  The 27 cells' slots are read
+  // as arrays (no chain of dependent loads) and the candidates kept without a branch (about one
+  // in seven is kept, at random); the lists are written after the scan.
   void fill_list(std::uint32_t i, bool only_higher) {
     const Vec3& ci = cage_[i];
     const double reach2 = (sigma_ + shell_) * (sigma_ + shell_);
     // the three wrapped cell indices along each axis (no division in the loop)
     int around[3][3];
+    std::uint32_t found[kMaxNeighbours + 1];
+    std::uint32_t m = 0;
     for (int k = 0; k < 3; ++k) {
       const int c = axis_cell(ci[k], k);
       around[k][0] = c == 0 ? ncell_[k] - 1 : c - 1;
@@ -260,37 +264,51 @@ class SphereEngine {
       for (int dy = 0; dy < 3; ++dy) {
         const int row = (around[2][dz] * ncell_[1] + around[1][dy]) * ncell_[0];
         for (int dx = 0; dx < 3; ++dx) {
-          for (std::uint32_t j = head_[row + around[0][dx]]; j != kNone; j = next_[j]) {
-            if (j == i || (only_higher && j < i)) continue;
+          const std::uint32_t* cell = &slot_[std::size_t(row + around[0][dx]) * cap_];
+          const std::uint32_t nc = used_[row + around[0][dx]];
+          for (std::uint32_t q = 0; q < nc; ++q) {
+            const std::uint32_t j = cell[q];
             const Vec3& cj = cage_[j];
             const double ex = image(cj.x() - ci.x(), 0), ey = image(cj.y() - ci.y(), 1),
                          ez = image(cj.z() - ci.z(), 2);
-            if (ex * ex + ey * ey + ez * ez < reach2) {
-              push(i, j);
-              push(j, i);
-            }
+            const bool take = (ex * ex + ey * ey + ez * ez < reach2) & (j != i) &
+                              (!only_higher | (j > i));
+            found[m < kMaxNeighbours ? m : kMaxNeighbours] = j;
+            m += take;
           }
         }
       }
+    if (m > kMaxNeighbours) push_overflow(i);
+    for (std::uint32_t k = 0; k < m; ++k) {
+      push(i, found[k]);
+      push(found[k], i);
+    }
+  }
+
+  [[noreturn]] void push_overflow(std::uint32_t i) const {
+    throw std::runtime_error("SphereEngine: more than " + std::to_string(kMaxNeighbours) +
+                             " neighbours of sphere " + std::to_string(p_[i].id) +
+                             "; use a smaller shell");
   }
   void push(std::uint32_t i, std::uint32_t j) {
     const std::uint32_t nn = p_[i].nn;
-    if (nn == kMaxNeighbours)
-      throw std::runtime_error("SphereEngine: more than " + std::to_string(kMaxNeighbours) +
-                               " neighbours of sphere " + std::to_string(p_[i].id) +
-                               "; use a smaller shell");
+    if (nn == kMaxNeighbours) push_overflow(i);
     nb_[std::size_t(i) * kMaxNeighbours + nn] = j;
     p_[i].nn = nn + 1;
   }
-  void remove(std::uint32_t j, std::uint32_t i) {  // i from j's list
+  // i from j's list.  The search compares all kMaxNeighbours slots (a fixed count: the compiler
+  // unrolls it into a few vector compares, with no loop exit to mispredict) and keeps the listed
+  // ones; i is listed (the lists are symmetric).
+  void remove(std::uint32_t j, std::uint32_t i) {
     std::uint32_t* l = &nb_[std::size_t(j) * kMaxNeighbours];
     const std::uint32_t nn = p_[j].nn;
-    for (std::uint32_t k = 0; k < nn; ++k)
-      if (l[k] == i) {
-        l[k] = l[nn - 1];
-        p_[j].nn = nn - 1;
-        return;
-      }
+    std::uint32_t found = 0;
+    for (int k = 0; k < kMaxNeighbours; ++k) found |= std::uint32_t(l[k] == i) << k;
+    found &= (std::uint32_t(1) << nn) - 1;
+    if (found == 0) return;
+    const int k = __builtin_ctz(found);
+    l[k] = l[nn - 1];
+    p_[j].nn = nn - 1;
   }
 
   // Sphere i (advanced to now) takes a new cage at its position.
@@ -307,13 +325,47 @@ class SphereEngine {
     cage_[i] = Vec3(p_[i].x, p_[i].y, p_[i].z);
     const std::uint32_t c_new = cell_of(cage_[i]);
     if (c_new != c_old) {
-      std::uint32_t* link = &head_[c_old];
-      while (*link != i) link = &next_[*link];
-      *link = next_[i];
-      next_[i] = head_[c_new];
-      head_[c_new] = i;
+      std::uint32_t* cell = &slot_[std::size_t(c_old) * cap_];
+      const std::uint32_t nc = used_[c_old];
+      std::uint32_t q = 0;
+      while (cell[q] != i) ++q;
+      cell[q] = cell[nc - 1];
+      used_[c_old] = std::uint8_t(nc - 1);
+      insert_cell(c_new, i);
     }
     fill_list(i, false);
+  }
+
+  void insert_cell(std::uint32_t c, std::uint32_t i) {
+    if (used_[c] == cap_) {  // a crowded cell: one more slot in every cell
+      ++growths_;
+      grow_cells();
+      rebuild_cells();
+      return;  // the rebuild placed i (its new centre is set)
+    }
+    slot_[std::size_t(c) * cap_ + used_[c]] = i;
+    used_[c] = std::uint8_t(used_[c] + 1);
+  }
+  // Every cell from the cage centres, each in increasing record order.
+  void rebuild_cells() {
+    const std::uint32_t n = static_cast<std::uint32_t>(p_.size());
+    const std::size_t cells = std::size_t(ncell_[0]) * ncell_[1] * ncell_[2];
+    for (;;) {
+      slot_.assign(cells * cap_, 0);
+      used_.assign(cells, 0);
+      bool fits = true;
+      for (std::uint32_t k = 0; k < n && fits; ++k) {
+        const std::uint32_t c = cell_of(cage_[k]);
+        if (used_[c] == cap_) fits = false;
+        else slot_[std::size_t(c) * cap_ + used_[c]++] = k;
+      }
+      if (fits) return;
+      grow_cells();
+    }
+  }
+  void grow_cells() {
+    if (cap_ == 255) throw std::runtime_error("SphereEngine: more than 255 cage centres in a grid cell");
+    ++cap_;
   }
 
   // Morton code of a cell: the bits of its three indices interleaved.
@@ -379,12 +431,7 @@ class SphereEngine {
     }
     q_.reset(n, q_.width(), q_.lists(), now_);
     for (std::uint32_t k = 0; k < n; ++k) q_.set(k, event[k].time, event[k].partner, event[k].count);
-    std::fill(head_.begin(), head_.end(), kNone);
-    for (std::uint32_t k = n; k-- > 0;) {  // each cell's chain in increasing record order
-      const std::uint32_t c = cell_of(cage_[k]);
-      next_[k] = head_[c];
-      head_[c] = k;
-    }
+    rebuild_cells();
   }
 
   void collide(std::uint32_t i, std::uint32_t j) {
@@ -457,7 +504,11 @@ class SphereEngine {
   std::vector<Vec3> cage_;
   std::vector<std::uint32_t> nb_;
   Calendar q_;
-  std::vector<std::uint32_t> head_, next_;
+  // The grid of cage centres: cell c's spheres are slot_[c cap_ + k], k < used_[c].
+  std::vector<std::uint32_t> slot_;
+  std::vector<std::uint8_t> used_;
+  std::uint32_t cap_;
+  std::uint64_t growths_ = 0;
   std::uint64_t collisions_ = 0, cages_ = 0, stale_ = 0;
   std::uint64_t events_ = 0, reorder_every_ = 0, next_reorder_ = 0;
 };

@@ -38,6 +38,7 @@ double energy(const State& s) {
 }  // namespace
 
 TEST(SphereEngine, SameCollisionsAsTheGenericLoop) {
+  std::uint64_t growths = 0;  // grid cells that overflowed during the runs
   for (const double phi : {0.3, 0.5}) {
     for (const double shell : {0.05, 0.3, 0.5}) {
       for (const std::uint64_t reorder : {std::uint64_t(0), std::uint64_t(37)}) {
@@ -48,7 +49,9 @@ TEST(SphereEngine, SameCollisionsAsTheGenericLoop) {
         Box box;
         const State start = hard_sphere_start(spec, box);
         auto sim = make_hard_sphere_cell_simulation(spec);
-        SphereEngine fast(box, start, spec.sigma, shell);
+        // Without re-sorts (which rebuild the grid), the grid cells start with one slot each:
+        // the overflow path runs, and a sphere it lost from the grid would stay lost.
+        SphereEngine fast(box, start, spec.sigma, shell, 0.0, reorder == 0 ? 1 : 8);
         fast.set_reorder_interval(reorder);  // records re-sorted every 37 events, or never again
         int compared = 0;
         double worst_dt = 0.0;
@@ -68,12 +71,15 @@ TEST(SphereEngine, SameCollisionsAsTheGenericLoop) {
           ++compared;
         }
         std::printf("  phi %.2f shell %.2f reorder %llu: %d collisions equal, largest time "
-                    "difference %.2e, %llu cage exits\n",
+                    "difference %.2e, %llu cage exits, %u cell slots (%llu overflows in the run)\n",
                     phi, shell, (unsigned long long)reorder, compared, worst_dt,
-                    (unsigned long long)fast.cage_exits());
+                    (unsigned long long)fast.cage_exits(), fast.cell_capacity(),
+                    (unsigned long long)fast.cell_growths());
+        growths += fast.cell_growths();
       }
     }
   }
+  EXPECT_GT(growths, 0u);  // the overflow path ran at least once between compared collisions
 }
 
 TEST(SphereEngine, NoOverlapsAndConservation) {
@@ -83,7 +89,8 @@ TEST(SphereEngine, NoOverlapsAndConservation) {
   spec.seed = 7;
   Box box;
   const State start = hard_sphere_start(spec, box);
-  SphereEngine fast(box, start, spec.sigma, 0.2);
+  SphereEngine fast(box, start, spec.sigma, 0.2, 0.0, 1);  // cells start with one slot
+  fast.set_reorder_interval(0);  // never rebuild the grid: what an overflow did stays
   const double e0 = energy(start);
   const Vec3 p0 = momentum(start);
   double worst = kInf;
@@ -100,10 +107,12 @@ TEST(SphereEngine, NoOverlapsAndConservation) {
   const State s = fast.state();
   const double drift = (energy(s) - e0) / e0;
   std::printf("  %llu collisions, %llu cage exits, %llu stale: smallest gap %.3e, energy drift "
-              "%.2e, |dP| %.2e\n",
+              "%.2e, |dP| %.2e; %u cell slots (%llu overflows in the run)\n",
               (unsigned long long)fast.collisions(), (unsigned long long)fast.cage_exits(),
               (unsigned long long)fast.stale_events(), worst,
-              drift, (momentum(s) - p0).norm());
+              drift, (momentum(s) - p0).norm(), fast.cell_capacity(),
+              (unsigned long long)fast.cell_growths());
+  EXPECT_GT(fast.cell_growths(), 0u);
   EXPECT_GT(fast.cage_exits(), per_round / 20);
   EXPECT_GT(worst, -1e-10);
   EXPECT_LT(std::abs(drift), 1e-12);
