@@ -74,6 +74,13 @@ class SphereEngine {
         cap_(std::max<std::uint32_t>(1, cell_capacity)) {
     if (!box.fully_periodic()) throw std::invalid_argument("SphereEngine: the box must be periodic");
     if (!(shell > 0.0)) throw std::invalid_argument("SphereEngine: the shell must be positive");
+    // A cage centre is the float nearest the sphere's position: within sqrt(3) ulp(L) / 2 of it.
+    // The cage's radius s / 2 must dwarf that (else a new cage could already be left).
+    const double far = std::ldexp(std::sqrt(3.0) / 2.0, std::ilogb(box.L.maxCoeff()) - 23);
+    if (!(0.5 * shell > 128.0 * far))
+      throw std::invalid_argument("SphereEngine: the shell is too thin for this box (cage centres "
+                                  "are single precision; it must exceed " +
+                                  std::to_string(256.0 * far) + ")");
     const std::size_t n = s.size();
     if (n == 0) throw std::invalid_argument("SphereEngine: no spheres");
     p_.resize(n);
@@ -95,7 +102,7 @@ class SphereEngine {
         throw std::invalid_argument("SphereEngine: the box is smaller than 3 cells of sigma + shell");
       cell_len_[k] = L_[k] / ncell_[k];
     }
-    for (std::uint32_t i = 0; i < n; ++i) cage_[i] = Vec3(p_[i].x, p_[i].y, p_[i].z);
+    for (std::uint32_t i = 0; i < n; ++i) cage_[i] = Cage(p_[i]);
     rebuild_cells();
     for (std::uint32_t i = 0; i < n; ++i) fill_list(i, /*only_higher=*/true);
     const std::uint32_t lists = std::max<std::uint32_t>(16, std::uint32_t(n / 4));  // 2 B/sphere
@@ -183,7 +190,7 @@ class SphereEngine {
 
   // Bytes held per sphere (every array, the cell heads and the calendar included).
   std::size_t bytes_per_sphere() const {
-    const std::size_t b = p_.capacity() * sizeof(Sph) + cage_.capacity() * sizeof(Vec3) +
+    const std::size_t b = p_.capacity() * sizeof(Sph) + cage_.capacity() * sizeof(Cage) +
                           nb_.capacity() * sizeof(std::uint32_t) +
                           q_.bytes() + slot_.capacity() * sizeof(std::uint32_t) + used_.capacity();
     return p_.empty() ? 0 : (b + p_.size() - 1) / p_.size();
@@ -198,6 +205,18 @@ class SphereEngine {
     std::uint32_t nn : 8;      // neighbours listed
   };
   static_assert(kMaxNeighbours < 256, "nn has 8 bits");
+  // A cage centre, in single precision (12 bytes instead of 24).  The centre is whatever the
+  // float holds: the cage exit and the lists are both computed from that same point, so the
+  // guarantee (unlisted pairs cannot touch) is exact as before; the sphere starts within a
+  // float's rounding of its centre (7e-6 at L = 100), far inside its cage (the constructor
+  // checks that the shell is at least 256 times that).
+  struct Cage {
+    float x = 0.0f, y = 0.0f, z = 0.0f;
+    Cage() = default;
+    explicit Cage(const Sph& q)
+        : x(static_cast<float>(q.x)), y(static_cast<float>(q.y)), z(static_cast<float>(q.z)) {}
+    double operator[](int k) const { return k == 0 ? x : k == 1 ? y : z; }
+  };
   // Sphere i's event is its time in the calendar, with the partner (kCage for a cage exit) as its
   // tag and the partner's count at prediction as its stamp; it is stale once the partner's count
   // moved on (a wrap of 2^24 velocity changes of the partner within one event's lifetime is out
@@ -210,7 +229,7 @@ class SphereEngine {
   int axis_cell(double x, int k) const {
     return std::min(ncell_[k] - 1, static_cast<int>(x / cell_len_[k]));
   }
-  std::uint32_t cell_of(const Vec3& c) const {
+  std::uint32_t cell_of(const Cage& c) const {
     int idx[3];
     for (int k = 0; k < 3; ++k) idx[k] = axis_cell(c[k], k);
     return std::uint32_t((idx[2] * ncell_[1] + idx[1]) * ncell_[0] + idx[0]);
@@ -248,7 +267,7 @@ class SphereEngine {
   // as arrays (no chain of dependent loads) and the candidates kept without a branch (about one
   // in seven is kept, at random); the lists are written after the scan.
   void fill_list(std::uint32_t i, bool only_higher) {
-    const Vec3& ci = cage_[i];
+    const Cage ci = cage_[i];
     const double reach2 = (sigma_ + shell_) * (sigma_ + shell_);
     // the three wrapped cell indices along each axis (no division in the loop)
     int around[3][3];
@@ -268,9 +287,9 @@ class SphereEngine {
           const std::uint32_t nc = used_[row + around[0][dx]];
           for (std::uint32_t q = 0; q < nc; ++q) {
             const std::uint32_t j = cell[q];
-            const Vec3& cj = cage_[j];
-            const double ex = image(cj.x() - ci.x(), 0), ey = image(cj.y() - ci.y(), 1),
-                         ez = image(cj.z() - ci.z(), 2);
+            const Cage& cj = cage_[j];
+            const double ex = image(double(cj.x) - ci.x, 0), ey = image(double(cj.y) - ci.y, 1),
+                         ez = image(double(cj.z) - ci.z, 2);
             const bool take = (ex * ex + ey * ey + ez * ez < reach2) & (j != i) &
                               (!only_higher | (j > i));
             found[m < kMaxNeighbours ? m : kMaxNeighbours] = j;
@@ -322,7 +341,7 @@ class SphereEngine {
     for (std::uint32_t k = 0; k < nn; ++k) remove(l[k], i);
     p_[i].nn = 0;
     const std::uint32_t c_old = cell_of(cage_[i]);
-    cage_[i] = Vec3(p_[i].x, p_[i].y, p_[i].z);
+    cage_[i] = Cage(p_[i]);
     const std::uint32_t c_new = cell_of(cage_[i]);
     if (c_new != c_old) {
       std::uint32_t* cell = &slot_[std::size_t(c_old) * cap_];
@@ -408,7 +427,7 @@ class SphereEngine {
     for (std::uint32_t s = 0; s < n; ++s) {
       if (done[s]) continue;
       const Sph ps = p_[s];
-      const Vec3 cs = cage_[s];
+      const Cage cs = cage_[s];
       std::copy_n(&nb_[std::size_t(s) * kMaxNeighbours], kMaxNeighbours, block);
       std::uint32_t k = s;
       for (;;) {  // record k takes record perm[k]
@@ -451,8 +470,8 @@ class SphereEngine {
     advance(i);
     const Sph& a = p_[i];
     // cage exit
-    const Vec3& c = cage_[i];
-    const double px = image(a.x - c.x(), 0), py = image(a.y - c.y(), 1), pz = image(a.z - c.z(), 2);
+    const Cage c = cage_[i];
+    const double px = image(a.x - c.x, 0), py = image(a.y - c.y, 1), pz = image(a.z - c.z, 2);
     const double va = a.vx * a.vx + a.vy * a.vy + a.vz * a.vz;
     const double pb = px * a.vx + py * a.vy + pz * a.vz;
     const double pc = std::min(0.0, px * px + py * py + pz * pz - 0.25 * shell_ * shell_);
@@ -501,7 +520,7 @@ class SphereEngine {
   int ncell_[3];
   double cell_len_[3];
   std::vector<Sph> p_;
-  std::vector<Vec3> cage_;
+  std::vector<Cage> cage_;
   std::vector<std::uint32_t> nb_;
   Calendar q_;
   // The grid of cage centres: cell c's spheres are slot_[c cap_ + k], k < used_[c].

@@ -128,6 +128,8 @@ TEST(SphereEngine, RejectsBadInput) {
   spec.n = 500;
   const State s2 = hard_sphere_start(spec, box);
   EXPECT_THROW(SphereEngine(box, s2, 1.0, 0.0), std::invalid_argument);
+  EXPECT_THROW(SphereEngine(box, s2, 1.0, 1e-5), std::invalid_argument);  // thinner than floats
+  EXPECT_NO_THROW(SphereEngine(box, s2, 1.0, 1e-3));
   Box walled = box;
   walled.periodic[2] = false;
   EXPECT_THROW(SphereEngine(walled, s2, 1.0, 0.2), std::invalid_argument);
