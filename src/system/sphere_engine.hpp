@@ -21,6 +21,7 @@
 //    cage centres with cells of side >= sigma + s; a centre changes cell only there, so there
 //    are no cell-crossing events).  Each cell is a block of slots of one size for all cells
 //    (8 to start with; one more whenever a cell overflows), read as an array.
+//  * Periodic images only for spheres whose cage centre lies near a face (predict, below).
 //  * Early rejection before any square root.  For an approaching pair (b = r.v < 0) outside
 //    contact (c = r^2 - sigma^2 >= 0) the first root t = c / (sqrt(b^2 - a c) - b) satisfies
 //    t >= c / (-2 b) (sqrt(b^2 - a c) <= -b), so a pair with c >= -2 b t_best cannot beat the
@@ -70,7 +71,9 @@ class SphereEngine {
   // per grid cell to start with (they grow by one whenever a cell overflows; tests start at 1).
   SphereEngine(const Box& box, const State& s, double sigma, double shell, double now = 0.0,
                std::uint32_t cell_capacity = 8)
-      : L_(box.L), hL_(0.5 * box.L), sigma_(sigma), shell_(shell), now_(now),
+      : L_(box.L), hL_(0.5 * box.L), sigma_(sigma), shell_(shell),
+        inner_(sigma + 2.0 * shell < 0.5 * box.L.minCoeff() ? sigma + 2.0 * shell : kInf),
+        now_(now),
         cap_(std::max<std::uint32_t>(1, cell_capacity)) {
     if (!box.fully_periodic()) throw std::invalid_argument("SphereEngine: the box must be periodic");
     if (!(shell > 0.0)) throw std::invalid_argument("SphereEngine: the shell must be positive");
@@ -481,19 +484,33 @@ class SphereEngine {
       best = pb > 0.0 ? -pc / (pb + sq) : (sq - pb) / va;
     }
     std::uint32_t partner = kCage;
-    const double s2 = sigma_ * sigma_;
     const std::uint32_t* l = &nb_[std::size_t(i) * kMaxNeighbours];
     const std::uint32_t nn = a.nn;
     // The neighbours' records are the loads that miss at large N: ask for all of them at once.
     for (std::uint32_t k = 0; k < nn; ++k) __builtin_prefetch(&p_[l[k]]);
+    // Periodic images only near the faces.  A listed j has |c_j - c_i| < sigma + s, and both
+    // spheres are inside their cages (radius s / 2) until their events: with c_i more than
+    // sigma + 2 s from every face, both positions lie inside the box, so their plain difference
+    // (shorter than sigma + 2 s < L / 2) is the minimum image.
+    const double m = inner_;
+    if (c.x > m && c.x < L_[0] - m && c.y > m && c.y < L_[1] - m && c.z > m && c.z < L_[2] - m)
+      pairs<false>(a, l, nn, best, partner);
+    else
+      pairs<true>(a, l, nn, best, partner);
+    q_.set(i, now_ + best, partner, partner == kCage ? 0u : std::uint32_t(p_[partner].count));
+  }
+  // The earliest collision of a with its listed spheres l[0, nn) that beats best.
+  template <bool Images>
+  void pairs(const Sph& a, const std::uint32_t* l, std::uint32_t nn, double& best,
+             std::uint32_t& partner) const {
+    const double s2 = sigma_ * sigma_;
     for (std::uint32_t k = 0; k < nn; ++k) {
       const std::uint32_t j = l[k];
       const Sph& b = p_[j];
       const double dt = now_ - b.t;
       const double dvx = b.vx - a.vx, dvy = b.vy - a.vy, dvz = b.vz - a.vz;
-      const double rx = image(b.x + b.vx * dt - a.x, 0);
-      const double ry = image(b.y + b.vy * dt - a.y, 1);
-      const double rz = image(b.z + b.vz * dt - a.z, 2);
+      double rx = b.x + b.vx * dt - a.x, ry = b.y + b.vy * dt - a.y, rz = b.z + b.vz * dt - a.z;
+      if constexpr (Images) rx = image(rx, 0), ry = image(ry, 1), rz = image(rz, 2);
       const double bb = rx * dvx + ry * dvy + rz * dvz;
       const double cc = rx * rx + ry * ry + rz * rz - s2;
       // Receding (bb >= 0), or t >= c / (-2b) >= best: cannot win.  One branch for both tests
@@ -511,11 +528,13 @@ class SphereEngine {
       }
       if (t < best) best = t, partner = j;
     }
-    q_.set(i, now_ + best, partner, partner == kCage ? 0u : std::uint32_t(p_[partner].count));
   }
 
   Vec3 L_, hL_;
   double sigma_, shell_;
+  // A sphere whose cage centre is farther than this from every face has no neighbour across
+  // one (below), so its pairs need no periodic image; kInf when boxes are too small for that.
+  double inner_;
   double now_;
   int ncell_[3];
   double cell_len_[3];
