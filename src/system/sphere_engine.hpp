@@ -347,17 +347,20 @@ class SphereEngine {
     cage_[i] = Cage(p_[i]);
     const std::uint32_t c_new = cell_of(cage_[i]);
     if (c_new != c_old) {
-      std::uint32_t* cell = &slot_[std::size_t(c_old) * cap_];
-      const std::uint32_t nc = used_[c_old];
-      std::uint32_t q = 0;
-      while (cell[q] != i) ++q;
-      cell[q] = cell[nc - 1];
-      used_[c_old] = std::uint8_t(nc - 1);
+      erase_cell(c_old, i);
       insert_cell(c_new, i);
     }
     fill_list(i, false);
   }
 
+  void erase_cell(std::uint32_t c, std::uint32_t i) {  // i is in cell c
+    std::uint32_t* cell = &slot_[std::size_t(c) * cap_];
+    const std::uint32_t nc = used_[c];
+    std::uint32_t q = 0;
+    while (cell[q] != i) ++q;
+    cell[q] = cell[nc - 1];
+    used_[c] = std::uint8_t(nc - 1);
+  }
   void insert_cell(std::uint32_t c, std::uint32_t i) {
     if (used_[c] == cap_) {  // a crowded cell: one more slot in every cell
       ++growths_;
@@ -386,7 +389,8 @@ class SphereEngine {
     }
   }
   void grow_cells() {
-    if (cap_ == 255) throw std::runtime_error("SphereEngine: more than 255 cage centres in a grid cell");
+    if (cap_ == 255)  // used_ counts in 8 bits
+      throw std::runtime_error("SphereEngine: more than 255 cage centres in a grid cell");
     ++cap_;
   }
 
