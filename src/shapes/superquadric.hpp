@@ -386,6 +386,17 @@ struct Superquadric {
       g[i] = std::copysign(e[i] / (E * ax[i]) * P.d1[i], x[i]);
     return g;
   }
+  // The Halley start (1 + K)^(-1/(2p-2)): from the bits of 1 + K for p <= 11, single-precision
+  // pow above (measured, both ways, per support point: p = 4 -15 % and p = 8 -8 % with the
+  // bits; p = 16 and 20 +9 % and +14 %: the bits' 0.4 % error costs a Halley step where x0 is
+  // close to the root).
+  template <int PM1>
+  double flat_start(double K) const {
+    if constexpr (PM1 > 0 && PM1 <= 10) return rough_power(1.0 + K, -inv_2p_2_);
+    if (K < 1e37)
+      return std::pow(static_cast<float>(1.0 + K), -static_cast<float>(inv_2p_2_));
+    return std::pow(1.0 + K, -inv_2p_2_);
+  }
   // The support point of a (2, 2, p) body with integer p (axis k = flat_axis_ has exponent p)
   // without a power per iteration.  The Lagrange conditions t_i = (c_i y)^(1/(e_i-1)) give, in
   // x = t_k, y = x^(p-1) / c_k and t_i = c_i y on the two exponent-2 axes, so the constraint
@@ -411,13 +422,7 @@ struct Superquadric {
     if (!(ck > 0.0)) return false;
     const double K = (cc[i] * cc[i] + cc[j] * cc[j]) / (ck * ck);
     if (!(K <= 1e250)) return false;
-    // the start from the bits of 1 + K for p <= 11, single-precision pow above (measured, both
-    // ways, per support point: p = 4 -15 % and p = 8 -8 % with the bits; p = 16 and 20 +9 % and
-    // +14 %: the bits' 0.4 % error costs a Halley step where x0 is close to the root)
-    double x = PM1 > 0 && PM1 <= 10 ? rough_power(1.0 + K, -inv_2p_2_)
-               : K < 1e37           ? std::pow(static_cast<float>(1.0 + K), -static_cast<float>(inv_2p_2_))
-                                    : std::pow(1.0 + K, -inv_2p_2_),
-           xp1 = 0.0;
+    double x = flat_start<PM1>(K), xp1 = 0.0;
     for (int it = 0; it < 100; ++it) {
       xp1 = power(x);  // x^(p-1)
       const double w3 = xp1 * x, w12 = K * xp1 * xp1;
