@@ -409,9 +409,9 @@ struct FreeRotation {
     const double half = 0.5 * wn * dt;
     Quat inc = Quat::Identity();
     if (half != 0.0) {
-      const double s =
-          (std::abs(half) < 1e-4) ? 0.5 * dt * (1.0 - half * half / 6.0) : std::sin(half) / wn;
-      inc = Quat(std::cos(half), s * w.x(), s * w.y(), s * w.z());
+      const double sn = std::sin(half), cs = std::cos(half);  // one sincos call
+      const double s = (std::abs(half) < 1e-4) ? 0.5 * dt * (1.0 - half * half / 6.0) : sn / wn;
+      inc = Quat(cs, s * w.x(), s * w.y(), s * w.z());
     }
     Quat q = inc * q0;
     q.normalize();
