@@ -144,11 +144,13 @@ void predict_contacts(const State& s, const Box& box, std::uint32_t i, const std
                       const Vec3* shifts, std::size_t n, double now, const double* horizons,
                       double* out, double law_end, bool trim, SolverStats& stats, Solve&& solve,
                       Fail&& fail) {
+  if (n > 0) s.prefetch(js[0]);
   const BodyState a = s.body(i);  // body i is at `now`
   double earliest = kInf;
   for (std::size_t k = 0; k < n; ++k) {
     const std::uint32_t j = js[k];
     out[k] = kInf;
+    if (k + 1 < n) s.prefetch(js[k + 1]);  // the next candidate's record, while this one is solved
     const double horizon = trim ? std::min({horizons ? horizons[k] : kInf, law_end, earliest}) : law_end;
     if (j == i || !(horizon > now)) continue;
     BodyState b = s.body_at(j, now);
