@@ -49,7 +49,7 @@ FULL = dict(
     e1_seeds=[1, 2, 3], e1_warm=20000, e1_coll=50000,
     e2_x0=[0.1, 1.0, 2.0, 5.0, 10.0], e2_warm_pp=40, e2_coll=10000, e2_rounds=3,
     e3_coll=20000, e3_warm=20000,
-    e4_n=[256, 1024, 4096, 32000], e4_warm_pp=40, e4_coll=20000,
+    e4_n=[256, 1024, 4096, 32000, 256000], e4_warm_pp=40, e4_coll=20000,
     f_x0=[2.0, 0.5], f_p=[2, 3, 4, 5, 6, 8, 10, 12, 14, 16], f_warm=10000, f_coll=5000, f_budget=10,
     f_long_p=[16], f_long_coll=50000,
     f_ratio_coll=10000, f_ratio_warm=10000,
