@@ -33,19 +33,6 @@ struct BodyState {
 // Equal principal moments: w is constant in the lab frame.
 inline bool spherical_top(const Vec3& I) { return I[0] == I[1] && I[1] == I[2]; }
 
-// Quaternion of the rotation by the angle |w| dt about w (exact, no series truncation).
-inline Quat rotation_increment(const Vec3& w, double dt) {
-  const double wn = w.norm();
-  const double half = 0.5 * wn * dt;
-  if (half == 0.0) return Quat::Identity();
-  // sin(half)/wn is finite even for tiny wn: use sinc form to stay accurate. Both sin and cos
-  // are taken unconditionally so that the compiler makes them one sincos call (the same values;
-  // measured: separate sin and cos were 7 % of an ellipsoid run's profile).
-  const double sn = std::sin(half), cs = std::cos(half);
-  const double s = (std::abs(half) < 1e-4) ? 0.5 * dt * (1.0 - half * half / 6.0) : sn / wn;
-  return Quat(cs, s * w.x(), s * w.y(), s * w.z());
-}
-
 inline Vec3 position_at(const BodyState& b, double dt) { return b.r + b.v * dt; }
 
 inline Quat orientation_at(const BodyState& b, double dt) {
