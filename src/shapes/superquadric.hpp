@@ -392,10 +392,12 @@ struct Superquadric {
   // close to the root).
   template <int PM1>
   double flat_start(double K) const {
-    if constexpr (PM1 > 0 && PM1 <= 10) return rough_power(1.0 + K, -inv_2p_2_);
-    if (K < 1e37)
-      return std::pow(static_cast<float>(1.0 + K), -static_cast<float>(inv_2p_2_));
-    return std::pow(1.0 + K, -inv_2p_2_);
+    if constexpr (PM1 > 0 && PM1 <= 10) {
+      return rough_power(1.0 + K, -inv_2p_2_);
+    } else {
+      if (K < 1e37) return std::pow(static_cast<float>(1.0 + K), -static_cast<float>(inv_2p_2_));
+      return std::pow(1.0 + K, -inv_2p_2_);
+    }
   }
   // The support point of a (2, 2, p) body with integer p (axis k = flat_axis_ has exponent p)
   // without a power per iteration.  The Lagrange conditions t_i = (c_i y)^(1/(e_i-1)) give, in
