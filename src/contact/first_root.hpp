@@ -57,8 +57,9 @@
 //  which is mostly rotation for long bodies, so the search takes a few steps instead of a
 //  geometric series of them.
 //  4. Every bracket of the step is shrunk on the sign of d_f (Illinois + bisection) to a width
-//     of a few ulps of t and its left end (d_f >= 0) is kept; the earliest component wins. The
-//     time returned is therefore never later than the first root found.
+//     of a few ulps of t (or until d_f at its left end is at most FirstRootOptions::value_tol)
+//     and its left end (d_f >= 0) is kept; the earliest component wins. The time returned is
+//     therefore never later than the first root found.
 #pragma once
 #include <algorithm>
 #include <array>
@@ -104,6 +105,11 @@ struct FirstRootOptions {
                                 // the last safe time, `truncated` set)
   int brent_max_evals = 60;
   bool second_order = true;  // use curvature_bound where F has one (false: Lipschitz steps only)
+  // A bracket stops shrinking once its left end's value is at most this (a length: the time
+  // returned is then the root's up to value_tol / |d_f'| earlier, never later). 0: shrink to a
+  // few ulps (contacts, where the root itself is the event). The neighbour-list escape uses a
+  // fraction of its margin: rebuilding that little earlier is as valid and costs nothing.
+  double value_tol = 0.0;
 };
 
 struct FirstRoot {
@@ -205,7 +211,7 @@ FirstRoot first_root(const F& fn, double t_start, double t_max, double eps_in,
       }
       // shrink [t, hi] on the sign of d_f, keep the left end (d_f > 0)
       const RootBracket br = bracket_root([&](double x) { return fn.component_at(f, x); }, t,
-                                          d0[f], hi, dhi, ttol(hi), 200);
+                                          d0[f], hi, dhi, ttol(hi), 200, o.value_tol);
       if (br.lo < best_t) best_t = br.lo, best_f = f, best_d = br.flo;
     }
     if (best_f >= 0) {

@@ -82,14 +82,17 @@ struct RootBracket {
 
 // Shrink a sign-change bracket of f to width <= xtol: Illinois steps, with bisection whenever
 // the bracket did not at least halve in two steps.  Keeps both ends (the caller chooses one).
+// flo_tol > 0: stop also once |f(lo)| <= flo_tol (the left end is then close enough to the root
+// for a caller that keeps it; 0: shrink to xtol).
 template <class F>
 RootBracket bracket_root(F&& f, double lo, double flo, double hi, double fhi, double xtol,
-                         int max_evals) {
+                         int max_evals, double flo_tol = 0.0) {
   RootBracket br{lo, flo, hi, fhi, 0};
   int side = 0;  // which end was kept last time (for the Illinois halving)
   double width_before = hi - lo;
   int since_check = 0;
-  while (br.hi - br.lo > xtol && br.evals < max_evals) {
+  while (br.hi - br.lo > xtol && br.evals < max_evals &&
+         !(flo_tol > 0.0 && std::abs(br.flo) <= flo_tol)) {
     double t = br.lo + (br.hi - br.lo) * br.flo / (br.flo - br.fhi);
     if (++since_check == 3) {  // bisection safeguard
       if (br.hi - br.lo > 0.5 * width_before) t = 0.5 * (br.lo + br.hi);

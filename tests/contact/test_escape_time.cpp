@@ -215,6 +215,27 @@ TEST(EscapeTime, CurvatureBoundHoldsAlongFlights) {
   EXPECT_GT(worst, 0.2);  // and the bound is not absurdly loose
 }
 
+// A random flight from inside a box around the body: elongations up to 10, speeds and spins
+// over three decades, shells of 1 % to 50 % of the inscribed radius (the neighbour lists' margin).
+struct Flight {
+  Ellipsoid e;
+  BodyState s;
+  Obb box;
+  double margin, t_max;
+  EscapeInput<Ellipsoid> input() const { return {e, s, 0.0, 0.0, t_max, box, margin, margin}; }
+};
+Flight random_flight(testing::Rng& r) {
+  Flight f;
+  f.e = r.ellipsoid(10.0);
+  f.s = BodyState{r.ball(1.0), r.quat(), r.log_uni(0.01, 10.0) * r.unit(), r.log_uni(0.01, 30.0) * r.unit()};
+  const double shell = r.log_uni(0.01, 0.5) * f.e.inscribed_radius();
+  f.box = box_around(f.e, f.s, shell);
+  f.margin = std::min(0.01 * f.e.inscribed_radius(), 0.25 * shell);
+  const double K = f.s.v.norm() + f.s.w.norm() * f.e.bounding_radius();
+  f.t_max = 40.0 * (shell + 2.0) / K;
+  return f;
+}
+
 // The second-order steps against the slow twin (Lipschitz steps only): the same status, face
 // and time on random flights (both are bracketed to a few ulps), in fewer steps.
 TEST(EscapeTime, SecondOrderStepsGiveTheSameEscapesInFewerSteps) {
@@ -223,14 +244,8 @@ TEST(EscapeTime, SecondOrderStepsGiveTheSameEscapesInFewerSteps) {
   double worst = 0.0;
   const int n = hb::testing::scaled_count(4000, 0.05);
   for (int k = 0; k < n; ++k) {
-    const Ellipsoid e = r.ellipsoid(10.0);
-    BodyState s{r.ball(1.0), r.quat(), r.log_uni(0.01, 10.0) * r.unit(),
-                r.log_uni(0.01, 30.0) * r.unit()};
-    const double shell = r.log_uni(0.01, 0.5) * e.inscribed_radius();
-    const Obb box = box_around(e, s, shell);
-    const double margin = std::min(0.01 * e.inscribed_radius(), 0.25 * shell);
-    const double K = s.v.norm() + s.w.norm() * e.bounding_radius();
-    EscapeInput<Ellipsoid> in{e, s, 0.0, 0.0, 40.0 * (shell + 2.0) / K, box, margin, margin};
+    const Flight f = random_flight(r);
+    const EscapeInput<Ellipsoid> in = f.input();
     EscapeOptions slow;
     slow.second_order = false;
     const EscapeResult a = escape_time(in, slow), b = escape_time(in);
@@ -246,6 +261,35 @@ TEST(EscapeTime, SecondOrderStepsGiveTheSameEscapesInFewerSteps) {
   EXPECT_LE(worst, 1e-12);
   EXPECT_GT(escapes, n / 2);
   EXPECT_LT(2 * steps2, steps1);  // at least twice fewer steps
+}
+
+// FirstRootOptions::value_tol (the neighbour lists' escape: brackets stop once the body is
+// within value_tol of the shrunken face) against the brackets shrunk to a few ulps: the same
+// status, a time never later, and the returned face's distance there in [0, value_tol].
+TEST(EscapeTime, ValueToleranceStopsEarlierButNeverLater) {
+  testing::Rng r(31415);
+  long escapes = 0, earlier = 0;
+  const int n = hb::testing::scaled_count(4000, 0.05);
+  for (int k = 0; k < n; ++k) {
+    const Flight f = random_flight(r);
+    const EscapeInput<Ellipsoid> in = f.input();
+    EscapeOptions coarse;
+    coarse.value_tol = 0.1 * f.margin;
+    const EscapeResult a = escape_time(in), b = escape_time(in, coarse);
+    ASSERT_EQ(a.status, b.status) << "case " << k;
+    if (a.status != EscapeStatus::escapes) continue;
+    ++escapes;
+    EXPECT_LE(b.time, a.time) << "case " << k;
+    EXPECT_GE(b.distance, 0.0) << "case " << k;
+    EXPECT_LE(b.distance, coarse.value_tol) << "case " << k;
+    const BoxDistance<Ellipsoid> D(f.e, f.s, 0.0, f.box, f.margin);
+    EXPECT_GE(D.face_at(b.face, b.time), 0.0) << "case " << k;
+    if (b.time < a.time) ++earlier;
+  }
+  std::printf("[ ESCAPE ] %d flights, %ld escapes, %ld returned earlier with value_tol\n", n,
+              escapes, earlier);
+  EXPECT_GT(escapes, n / 2);
+  EXPECT_GT(earlier, escapes / 2);  // the tolerance does stop brackets early
 }
 
 TEST(EscapeTime, AlreadyOutsideGivesStartTime) {
