@@ -139,11 +139,16 @@ DistanceResult collision_distance(const SA& sa, const Quat& qa, const Pose& pa, 
 // the candidate's horizon, at law_end (where the growth law changes) and, with `trim`, at the
 // earliest contact found so far (later ones are not needed). solve(a, b, j, horizon) runs the
 // pair's contact-time solver; a failed solve throws SolverFailure(fail(a, b, j, horizon)).
+// window_radius > 0: the radius the solver's own first test uses (contact_time.hpp: the
+// bounding spheres' sum plus its margin; rigid pairs of one shape only). A candidate whose
+// bounding spheres cannot meet within its window is then rejected here, from its position
+// alone, before its orientation is streamed to `now` and a solver is set up: the same test on
+// the same numbers, so the same result (counted as the prediction it replaces).
 template <class Solve, class Fail>
 void predict_contacts(const State& s, const Box& box, std::uint32_t i, const std::uint32_t* js,
                       const Vec3* shifts, std::size_t n, double now, const double* horizons,
                       double* out, double law_end, bool trim, SolverStats& stats, Solve&& solve,
-                      Fail&& fail) {
+                      Fail&& fail, double window_radius = 0.0) {
   if (n > 0) s.prefetch(js[0]);
   const BodyState a = s.body(i);  // body i is at `now`
   double earliest = kInf;
@@ -153,8 +158,19 @@ void predict_contacts(const State& s, const Box& box, std::uint32_t i, const std
     if (k + 1 < n) s.prefetch(js[k + 1]);  // the next candidate's record, while this one is solved
     const double horizon = trim ? std::min({horizons ? horizons[k] : kInf, law_end, earliest}) : law_end;
     if (j == i || !(horizon > now)) continue;
+    const Vec3 rj = s.r[j] + s.v[j] * (now - s.t[j]);  // as State::body_at streams it
+    const Vec3 rb = shifts ? Vec3(rj + shifts[k]) : Vec3(a.r + box.near_image(rj - a.r));
+    if (window_radius > 0.0) {
+      BodyState b0;
+      b0.r = rb, b0.v = s.v[j];
+      double lo = now, hi = horizon;
+      if (!bounding_sphere_window(a, b0, now, window_radius, lo, hi) || !(lo <= hi)) {
+        stats.add(ContactResult{});  // the solver's answer to this test: none
+        continue;
+      }
+    }
     BodyState b = s.body_at(j, now);
-    b.r = shifts ? Vec3(b.r + shifts[k]) : Vec3(a.r + box.near_image(b.r - a.r));
+    b.r = rb;
     const ContactResult r = solve(a, b, j, horizon);
     stats.add(r);
     if (r.status == ContactStatus::failed) throw SolverFailure(fail(a, b, j, horizon));
@@ -251,7 +267,14 @@ struct RigidBodies {
               i, j, now,
               law.growing() ? fmt::format(" (growth scale {:.17g}, rate {:.17g})", sl.s, sl.rate) : "",
               law.growing() ? " at scale 1" : "", reproducer(a, b, horizon - now));
-        });
+        },
+        sl.active() ? 0.0 : window_radius());
+  }
+  // The radius of contact_time's bounding-sphere test for two bodies of this shape at scale 1
+  // (no growth): L_A + L_B + max(eps_d, 1e-9 L).
+  double window_radius() const {
+    const double L = shape.bounding_radius();
+    return (L + L) + std::max(eps_d, 1e-9 * L);
   }
 
   // Body i for the single-body event sources (walls): the shape at scale 1 with the growth.
