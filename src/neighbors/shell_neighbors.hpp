@@ -43,6 +43,13 @@ class AdjacencyLists {
     --size_[i];
   }
   void clear(std::uint32_t i) { size_[i] = 0; }
+  // A hint: list i's length and its first two cache lines (a list of ~30 entries), ahead of
+  // reading it.
+  void prefetch(std::uint32_t i) const {
+    __builtin_prefetch(&size_[i]);
+    __builtin_prefetch(begin(i));
+    __builtin_prefetch(begin(i) + 16);
+  }
 
  private:
   void grow() {

@@ -161,6 +161,8 @@ class Simulation {
         predict(i);
         return info;
       }
+      prefetch_neighbors(i);  // read when both are predicted after the impulse
+      prefetch_neighbors(j);
       state_.advance_to(i, now_);
       state_.advance_to(j, now_);
       bool moved;
@@ -256,9 +258,17 @@ class Simulation {
   }
   auto collect() {
     return [this](std::uint32_t j, const Vec3& shift) {
+      // windowed models read each candidate's calendar entry for its horizon (consider), after
+      // the owner's neighbour event is computed: ask for it now
+      if constexpr (windowed() && requires { queue_.prefetch(j); }) queue_.prefetch(j);
       cand_.push_back(j);
       shift_.push_back(shift);
     };
+  }
+  // Hints for a body about to be predicted: its neighbour policy's records (ObbNeighbors: box
+  // and list), if the policy offers them.
+  void prefetch_neighbors(std::uint32_t i) const {
+    if constexpr (requires { nb_.prefetch(i); }) nb_.prefetch(i);
   }
   // Is the pair (i, j), both streamed to now, in contact now? Its contact time from the current
   // state is within the tolerance (the search looks no further than twice the tolerance). Models
