@@ -46,6 +46,7 @@
 #include <stdexcept>
 #include <type_traits>
 #include <variant>
+#include <utility>
 #include <vector>
 
 #include "contact/escape_time.hpp"
@@ -290,11 +291,20 @@ class ObbNeighbors {
     for (std::uint32_t i = 0; i < obb_.size(); ++i) link(i, box, [i](std::uint32_t j) { return j > i; });
   }
   // List i and j both ways for every j of the cell stencil with take(j) whose box overlaps i's.
+  // Two passes: the cell walk gathers the candidates and asks for their boxes, then the overlap
+  // tests read them (in the same order, so the same lists). At large N the boxes of a cell's
+  // bodies lie all over memory; one pass waited for each box before walking on (measured at
+  // N = 256000: 63 % of Simulation::step on that load).
   template <class Take>
   void link(std::uint32_t i, const Box& box, Take take) {
+    near_.clear();
     cells_.for_each_neighbor(i, box.L, [&](std::uint32_t j, const Vec3& shift) {
-      if (take(j) && overlap(i, j, shift, box)) lists_.add(i, j), lists_.add(j, i);
+      if (!take(j)) return;
+      __builtin_prefetch(&obb_[j]);
+      near_.push_back({j, shift});
     });
+    for (const auto& [j, shift] : near_)
+      if (overlap(i, j, shift, box)) lists_.add(i, j), lists_.add(j, i);
   }
 
   // A species of a mixture at scale 1.
@@ -315,6 +325,7 @@ class ObbNeighbors {
   CellList cells_;           // over box centres; changes only at rebuilds
   std::vector<Obb> obb_;
   std::vector<Quat> q_;
+  std::vector<std::pair<std::uint32_t, Vec3>> near_;  // link's candidates (scratch)
   AdjacencyLists lists_;
   std::uint64_t rebuilds_ = 0;
   mutable std::uint64_t truncated_ = 0;
