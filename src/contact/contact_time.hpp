@@ -362,6 +362,10 @@ inline bool bounding_sphere_window(const BodyState& a, const BodyState& b, doubl
   return lo <= hi;
 }
 
+// The margin contact_time adds to the sum of the bounding radii for its first test (run():
+// L the larger bounding radius): callers that run the same test ahead of it use this.
+inline double bounding_window_margin(double L, double eps_d) { return std::max(eps_d, 1e-9 * L); }
+
 // Time window (absolute) in which the bounding spheres overlap, intersected with [lo, hi].
 // Returns false if empty.
 inline bool bounding_sphere_window(const BodyState& a, const BodyState& b, double t_state,
@@ -749,7 +753,7 @@ struct Solver {
     // The window is widened by a margin: for bodies whose bounding sphere is tight (spheres)
     // the window would end exactly at touching, where the distance is zero up to rounding and
     // a rounding-negative sample would fake a contact.
-    const double margin = std::max(in.eps_d, 1e-9 * L);
+    const double margin = bounding_window_margin(L, in.eps_d);
     const double Lab = in.shape_a.bounding_radius() + in.shape_b.bounding_radius();
     if (grow && !(A.scale_at(lo) > 0.0 && (hi == kInf ? in.growth.rate >= 0.0 : A.scale_at(hi) > 0.0))) {
       failed = true;  // the scale law must stay positive over the window

@@ -45,8 +45,8 @@
 #include <cmath>
 #include <stdexcept>
 #include <type_traits>
-#include <variant>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include "contact/escape_time.hpp"

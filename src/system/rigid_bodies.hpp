@@ -271,10 +271,10 @@ struct RigidBodies {
         sl.active() ? 0.0 : window_radius());
   }
   // The radius of contact_time's bounding-sphere test for two bodies of this shape at scale 1
-  // (no growth): L_A + L_B + max(eps_d, 1e-9 L).
+  // (no growth): L_A + L_B plus its margin.
   double window_radius() const {
     const double L = shape.bounding_radius();
-    return (L + L) + std::max(eps_d, 1e-9 * L);
+    return (L + L) + bounding_window_margin(L, eps_d);
   }
 
   // Body i for the single-body event sources (walls): the shape at scale 1 with the growth.
