@@ -50,6 +50,7 @@
 #include "core/box.hpp"
 #include "core/state.hpp"
 #include "events/calendar.hpp"
+#include "math/morton.hpp"
 #include "math/types.hpp"
 
 namespace hb {
@@ -394,14 +395,6 @@ class SphereEngine {
     ++cap_;
   }
 
-  // Morton code of a cell: the bits of its three indices interleaved.
-  static std::uint64_t morton(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
-    std::uint64_t m = 0;
-    for (int b = 0; b < 21; ++b)
-      m |= (std::uint64_t((x >> b) & 1u) << (3 * b)) | (std::uint64_t((y >> b) & 1u) << (3 * b + 1)) |
-           (std::uint64_t((z >> b) & 1u) << (3 * b + 2));
-    return m;
-  }
   // Put the records in Morton order of their cage centres' cells and renumber everything that
   // names a record: lists, events, the calendar's slots and the cell lists.
   void reorder() {
@@ -412,12 +405,10 @@ class SphereEngine {
       std::uint32_t idx[3];
       for (int k = 0; k < 3; ++k)
         idx[k] = std::uint32_t(axis_cell(cage_[i][k], k));
-      key[i] = morton(idx[0], idx[1], idx[2]);
+      key[i] = morton_code(idx[0], idx[1], idx[2]);
     }
-    std::vector<std::uint32_t> perm(n), inv(n);
-    for (std::uint32_t i = 0; i < n; ++i) perm[i] = i;
-    std::stable_sort(perm.begin(), perm.end(),
-                     [&](std::uint32_t a, std::uint32_t b) { return key[a] < key[b]; });
+    const std::vector<std::uint32_t> perm = sorting_permutation(key);
+    std::vector<std::uint32_t> inv(n);
     for (std::uint32_t k = 0; k < n; ++k) inv[perm[k]] = k;
     // In place, cycle by cycle (the only copies are the keys, the permutation and the events).
     struct Event {
