@@ -73,6 +73,7 @@ struct EscapeResult {
   int face = -1;             // 0..5 (obb.hpp numbering)
   double distance = kInf;    // d_f at `time` (>= 0 for escapes, < 0 for outside)
   long steps = 0;
+  long bounds = 0;  // affine bounds evaluated (flat faces)
   int grazing_searches = 0;
   bool truncated = false;
 };
@@ -90,6 +91,12 @@ struct BoxDistance {
   Motion motion;         // the rotation (any top; motion/motion.hpp)
   double s0 = 1.0, sdot = 0.0;  // growth: scale s(t) = s0 + sdot (t - t_state)
   double smax = 1.0;            // bound of s(t) over the search window
+  Vec3 Q;                       // affine_bound's remainder coefficients L |m_k''|max per box axis
+  // The body frame at the time of the last evaluation with rates (affine_bound's start):
+  // column k of Rn is box axis k in the body frame, W the body-frame angular velocity.
+  mutable double frame_tau = kInf;
+  mutable Mat3 frame_Rn;
+  mutable Vec3 frame_W;
 
   BoxDistance(const S& s, const BodyState& b, double ts, const Obb& box, double margin,
               double scale = 1.0, double scale_rate = 0.0, double t_end = kInf)
@@ -97,6 +104,7 @@ struct BoxDistance {
         L(s.bounding_radius()), motion(b), s0(scale), sdot(scale_rate),
         smax(scale_rate > 0.0 ? scale + scale_rate * (t_end - ts) : scale) {
     st.r = b.r - box.centre;
+    for (int k = 0; k < 3; ++k) Q[k] = L * turn_bounds(motion, Vec3(axes.col(k))).mdd;
   }
   double scale_at(double t) const { return sdot == 0.0 ? s0 : s0 + sdot * (t - t_state); }
   // d_f at t for every face; with rates when dd is non-null.
@@ -110,6 +118,7 @@ struct BoxDistance {
     const Vec3 x = axes.transpose() * r;        // centre along the box axes
     const Mat3 Rn = R.transpose() * axes;       // column k: box axis k in the body frame
     const double sc = scale_at(t);
+    if (dd) frame_tau = tau, frame_Rn = Rn, frame_W = R.transpose() * w;
     for (int k = 0; k < 3; ++k) {
       const Vec3 nb = Rn.col(k);
       // A centrally symmetric shape has h(-n) = h(n) and p(-n) = -p(n) bit for bit: one
@@ -120,8 +129,18 @@ struct BoxDistance {
       double hm, hp;
       Vec3 pm, pp;
       if constexpr (CentrallySymmetric<S>) {
-        hp = hm = shape.support(nb);
-        if (dd) pp = R * shape.support_point(nb), pm = -pp;
+        if constexpr (SupportIsPointDot<S>) {  // one support point gives both, the same bits
+          if (dd) {
+            const Vec3 pb = shape.support_point(nb);
+            hp = hm = nb.dot(pb);
+            pp = R * pb, pm = -pp;
+          } else {
+            hp = hm = shape.support(nb);
+          }
+        } else {
+          hp = hm = shape.support(nb);
+          if (dd) pp = R * shape.support_point(nb), pm = -pp;
+        }
       } else {
         hm = shape.support(-nb), hp = shape.support(nb);
         if (dd) pm = R * shape.support_point(-nb), pp = R * shape.support_point(nb);
@@ -177,6 +196,31 @@ struct BoxDistance {
       return kInf;
     }
   }
+  // Rigid bodies (no growth): a concave lower bound of d_f(t + s) for every s >= 0, as the
+  // pair's (contact/axis_gap.hpp, AxisGap::affine_bound) for one body. With m(t) = R(t)^T u_k
+  // and W the body-frame angular velocity, m' = m x W and m(t + s) = m + s m' + r(s),
+  // |r| <= s^2 |m''|max / 2; support functions are sublinear and h(r) <= L |r|, so
+  //     d_f(t + s) >= lim_k -+ x_k(t + s) - s0 [h(+-(m + s m')) + L |m''|max s^2 / 2] = B_f(s),
+  // linear minus a convex function of an affine argument minus a parabola: concave, B_f(0) =
+  // d_f(t). It needs no radius of curvature, so flat faces (superquadric exponents > 2) get
+  // steps beyond first order (first_root's affine_step). One support function per bound.
+  bool has_affine_bound(int) const { return sdot == 0.0; }  // (a scale s(t) breaks concavity)
+  double affine_bound(int f, double t, double s) const {
+    const double tau = t - t_state;
+    if (tau != frame_tau) {
+      Quat q;
+      Vec3 w;
+      motion.pose(tau, q, w);
+      const Mat3 R = q.toRotationMatrix();
+      frame_tau = tau, frame_Rn = R.transpose() * axes, frame_W = R.transpose() * w;
+    }
+    const int k = f >> 1;
+    const Vec3 m = frame_Rn.col(k);
+    const Vec3 mm = m + s * m.cross(frame_W);
+    const double x = axes.col(k).dot(st.r + st.v * (tau + s));
+    const double h = (f & 1) ? shape.support(mm) : shape.support(Vec3(-mm));
+    return lim[k] + ((f & 1) ? -x : x) - s0 * (h + 0.5 * Q[k] * s * s);
+  }
   // |d_f'| <= K_f (a top that is not spherical: |w x u| <= max |w(t)|)
   double rate_bound(int f) const {
     const Vec3 u = axes.col(f >> 1);
@@ -198,6 +242,7 @@ EscapeResult escape_time(const EscapeInput<S>& in, const EscapeOptions& o = {}) 
   out.face = r.component;
   out.distance = r.value;
   out.steps = r.steps;
+  out.bounds = r.bounds;
   out.grazing_searches = r.grazing_searches;
   out.truncated = r.truncated;
   return out;

@@ -6,6 +6,8 @@
 //                   g >= eps (the floor eps keeps steps near a root at least eps / K long);
 //   curvature_step  from g >= 0 with rate g' and |g''| <= M: no zero before the positive root
 //                   of g + g' dt - M dt^2 / 2;
+//   affine_step     from g >= 0 with rate g' and a concave lower bound B(s) of g(t + s): no
+//                   zero before the trial point where B > 0, or before the chord's zero;
 //   dip_possible    a step [t0, t1] with g > 0 at both ends can hide a zero only if the
 //                   Lipschitz lower bound (g0 + g1 - K (t1 - t0)) / 2 is <= 0;
 //   find_dip        such a step with g turning inside it (g'(t0) < 0 < g'(t1)) is searched for
@@ -33,6 +35,9 @@
 //     double rate_bound(int f) const;                                 // K_f over the window
 // and optionally
 //     double curvature_bound(int f) const;     // M_f >= |d_f''| over the window (kInf: none)
+//     bool has_affine_bound(int f) const;      // and, for components without M_f:
+//     double affine_bound(int f, double t, double s) const;  // concave B_f(s) <= d_f(t + s),
+//                                              // B_f(0) = d_f(t) (t: the last value's time)
 // Output: the first time in the window at which some d_f reaches 0 (the left end of a bracket a
 // few ulps wide, so d_f >= 0 there), the component, and a status: found, none (no root in the
 // window) or negative (some d_f < 0 at t_start: time = t_start, the most negative component).
@@ -56,6 +61,12 @@
 //  approaching face the curvature step follows the real rate instead of the worst-case K_f,
 //  which is mostly rotation for long bodies, so the search takes a few steps instead of a
 //  geometric series of them.
+//  Affine steps (components without a curvature bound whose F gives a concave lower bound,
+//  unless FirstRootOptions::affine_steps is false: the slow twin): the rates come with every
+//  value, and the component with the shortest step takes the longer of its Lipschitz step and
+//  affine_step on its bound, which is rigorous too; repeated until the shortest step is one
+//  that took it (flat faces, whose support maps have no bounded curvature: a Newton step with
+//  a quadratic correction near an approaching face instead of a geometric series).
 //  4. Every bracket of the step is shrunk on the sign of d_f (Illinois + bisection) to a width
 //     of a few ulps of t (or until d_f at its left end is at most FirstRootOptions::value_tol)
 //     and its left end (d_f >= 0) is kept; the earliest component wins. The time returned is
@@ -84,6 +95,21 @@ inline double curvature_step(double g, double r, double M) {
   return r <= 0.0 ? 2.0 * g / (q - r) : (M > 0.0 ? (r + q) / M : kInf);
 }
 
+// From g >= 0 with rate r at t, and B(s) a concave lower bound of g(t + s) on [0, rest] with
+// B(0) = g: a step with no zero of g before it. Trial: where g's tangent reaches zero (at most
+// rest; 16 dt1 when the tangent never does, dt1 the first-order step). If B(trial) > 0 the
+// trial is safe (B is concave and positive at both ends); otherwise the chord from (0, g) to
+// (trial, B(trial)) reaches zero before B does (B lies above its chords), and that is the step.
+// Near a root approached at a finite rate this is a Newton step with a quadratic correction.
+template <class B>
+double affine_step(B&& bound, double g, double r, double rest, double dt1) {
+  double s = std::min(r < 0.0 ? g / -r : kInf, rest);
+  if (!(s < kInf)) s = 16.0 * dt1;
+  const double b = bound(s);
+  if (b > 0.0) return s;
+  return g > 0.0 ? s * (g / (g - b)) : 0.0;
+}
+
 // A step of length h with values g0, g1 > 0 at its ends can hide a zero only if the Lipschitz
 // lower bound of g on it, (g0 + g1 - K h) / 2 (the two cones from the ends meet there), is <= 0.
 inline bool dip_possible(double g0, double g1, double K, double h) { return g0 + g1 <= K * h; }
@@ -105,6 +131,9 @@ struct FirstRootOptions {
                                 // the last safe time, `truncated` set)
   int brent_max_evals = 60;
   bool second_order = true;  // use curvature_bound where F has one (false: Lipschitz steps only)
+  // Use F's affine_bound on the components without a curvature bound (false: Lipschitz steps
+  // only there, the slow twin).
+  bool affine_steps = true;
   // A bracket stops shrinking once its left end's value is at most this (a length: the time
   // returned is then the root's up to value_tol / |d_f'| earlier, never later). 0: shrink to a
   // few ulps (contacts, where the root itself is the event). The neighbour-list escape uses a
@@ -118,6 +147,7 @@ struct FirstRoot {
   int component = -1;
   double value = kInf;      // d_f at `time` (>= 0 when found, < 0 when negative)
   long steps = 0;
+  long bounds = 0;  // affine bounds evaluated
   int grazing_searches = 0;
   bool truncated = false;
 };
@@ -129,17 +159,29 @@ FirstRoot first_root(const F& fn, double t_start, double t_max, double eps_in,
                      const std::array<double, F::kComponents>* d_start = nullptr) {
   constexpr int m = F::kComponents;
   FirstRoot out;
-  std::array<double, m> K, d0, d1, M, dd0{}, dd1{};
-  std::array<double, m> safe{};  // per component: the rigorous curvature step of this step
+  std::array<double, m> K, d0, d1, dd0{}, dd1{};
+  std::array<double, m> M;
+  M.fill(kInf);
+  std::array<double, m> safe{};  // per component: the rigorous step (curvature or affine) of this step
+  std::array<bool, m> aff{};     // per component: affine steps
   double kmax = 0.0;
   for (int f = 0; f < m; ++f) kmax = std::max(kmax, K[f] = fn.rate_bound(f));
-  bool second = false;  // some component takes curvature steps
+  bool curv = false;  // some component takes curvature steps
   if constexpr (requires { fn.curvature_bound(0); }) {
     for (int f = 0; f < m; ++f) {
       M[f] = o.second_order ? fn.curvature_bound(f) : kInf;
-      second = second || std::isfinite(M[f]);
+      curv = curv || std::isfinite(M[f]);
     }
   }
+  bool affine = false;  // some component (without a curvature bound) takes affine steps
+  if constexpr (requires { fn.affine_bound(0, 0.0, 0.0); }) {
+    if (o.affine_steps)
+      for (int f = 0; f < m; ++f) {
+        aff[f] = !std::isfinite(M[f]) && fn.has_affine_bound(f);
+        affine = affine || aff[f];
+      }
+  }
+  const bool second = curv || affine;  // the rates come with every value
   double t = t_start;
   if (second) fn.at(t, d0, &dd0);  // the same values as d_start, with the rates
   else if (d_start) d0 = *d_start;
@@ -166,16 +208,35 @@ FirstRoot first_root(const F& fn, double t_start, double t_max, double eps_in,
       out.time = t;
       return out;
     }
-    double dt = kInf;
+    std::array<double, m> step;
     for (int f = 0; f < m; ++f) {
+      safe[f] = 0.0;
+      step[f] = kInf;
       if (!(K[f] > 0.0)) continue;
-      double step = lipschitz_step(d0[f], eps, K[f]);
-      if (second && std::isfinite(M[f])) {
+      step[f] = lipschitz_step(d0[f], eps, K[f]);
+      if (curv && std::isfinite(M[f])) {
         safe[f] = curvature_step(d0[f], dd0[f], M[f]);
-        step = std::max(step, safe[f]);
+        step[f] = std::max(step[f], safe[f]);
       }
-      dt = std::min(dt, step);
     }
+    // Affine steps, only where they can lengthen the step: the component with the shortest
+    // step takes its affine step, until the shortest one has taken it (at most m bounds).
+    if constexpr (requires { fn.affine_bound(0, 0.0, 0.0); }) {
+      std::array<bool, m> tried{};
+      for (;;) {
+        int g = 0;
+        for (int f = 1; f < m; ++f)
+          if (step[f] < step[g]) g = f;
+        if (!affine || !aff[g] || tried[g] || !(step[g] < kInf)) break;
+        tried[g] = true;
+        ++out.bounds;
+        safe[g] = affine_step([&](double s) { return fn.affine_bound(g, t, s); }, d0[g], dd0[g],
+                              t_max - t, step[g]);
+        step[g] = std::max(step[g], safe[g]);
+      }
+    }
+    double dt = kInf;
+    for (int f = 0; f < m; ++f) dt = std::min(dt, step[f]);
     const double t1 = std::min(t + dt, t_max);
     const double h = t1 - t;
     fn.at(t1, d1, second ? &dd1 : nullptr);
@@ -188,7 +249,7 @@ FirstRoot first_root(const F& fn, double t_start, double t_max, double eps_in,
       double hi = kInf, dhi = 0.0;
       if (d1[f] <= 0.0) {  // (a step of exactly d / K can land on the root: d1 = 0)
         hi = t1, dhi = d1[f];
-      } else if (!(second && h <= safe[f]) &&  // (no dip inside a rigorous curvature step)
+      } else if (!(h <= safe[f]) &&  // (no dip inside a rigorous curvature or affine step)
                  dip_possible(d0[f], d1[f], K[f], h)) {  // grazing search
         if (!rates) {
           fn.at(t, d0, &dd0);

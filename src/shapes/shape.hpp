@@ -49,6 +49,12 @@ concept SupportShape = Shape<S> && requires(const S& s, const Vec3& n) {
 template <class S>
 concept CentrallySymmetric = requires { requires S::kCentrallySymmetric; };
 
+// Shapes whose support(n) is computed as n.dot(support_point(n)) declare
+// `static constexpr bool kSupportIsPointDot = true`: a caller that needs both takes the dot
+// product itself, the same bits for one support point solve instead of two (superquadrics).
+template <class S>
+concept SupportIsPointDot = requires { requires S::kSupportIsPointDot; };
+
 // Shapes whose max_curvature_radius() is finite for every valid instance (ellipsoids, spheres)
 // declare `static constexpr bool kBoundedCurvature = true`: the contact-time solver then
 // compiles only its second-order axis steps for their pairs, not the flat-face ones

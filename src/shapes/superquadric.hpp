@@ -107,6 +107,7 @@ struct Superquadric {
   static constexpr const char* kName = "superquadric";
   // |x_i| only: h(-n) = h(n), p(-n) = -p(n) bit for bit (shapes/shape.hpp)
   static constexpr bool kCentrallySymmetric = true;
+  static constexpr bool kSupportIsPointDot = true;  // support() below
   double a = 1.0, b = 1.0, c = 1.0;  // semi-axes along body x, y, z
   double n = 2.0, m = 2.0, p = 2.0;  // exponents (>= 2) of |x/a|, |y/b|, |z/c|
 
