@@ -23,7 +23,9 @@
 // Lipschitz steps max(d_f, eps) / K_f, a grazing search where a hidden dip is possible, brackets
 // shrunk to a few ulps, the left end kept), so the time returned is never later than the first
 // contact with the shrunken box. Shapes of bounded curvature also give |d_f''| <= M_f
-// (curvature_bound), and the search then takes second-order steps where they are longer.
+// (curvature_bound), and the search then takes second-order steps where they are longer; flat
+// faces of rigid bodies (no curvature bound) take steps on a concave lower bound instead
+// (affine_bound).
 // Growth: with scale s(t) = scale + scale_rate (t - t_state) the body is its shape scaled by s(t)
 // about its centre (Lubachevsky–Stillinger starts against walls, locals/planar_walls.hpp):
 // d_f(t) = c - margin - n.r(t) - s(t) h(R(t)^T n), d_f' gains -s' h and its rotational part the
@@ -177,7 +179,8 @@ struct BoxDistance {
            sdot * shape.support(nb);
   }
   double component_at(int f, double t) const { return face_at(f, t); }
-  // |d_f''| <= M_f, for shapes of bounded curvature (kInf otherwise: Lipschitz steps only).
+  // |d_f''| <= M_f, for shapes of bounded curvature (kInf otherwise: Lipschitz steps, or for
+  // rigid bodies the affine steps of affine_bound below).
   // With m(t) = R(t)^T u (u the face's axis) and h the support function of the shape at scale 1,
   // d_f = lim_k -+ x_k(t) - s(t) h(+-m(t)) and x_k'' = 0 (free flight), so
   //     |d_f''| <= 2 |s'| |dh/dt| + s |d^2 h/dt^2|,   |dh/dt| <= L |m'|,
