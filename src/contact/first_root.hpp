@@ -223,11 +223,11 @@ FirstRoot first_root(const F& fn, double t_start, double t_max, double eps_in,
     // step takes its affine step, until the shortest one has taken it (at most m bounds).
     if constexpr (requires { fn.affine_bound(0, 0.0, 0.0); }) {
       std::array<bool, m> tried{};
-      for (;;) {
+      while (affine) {
         int g = 0;
         for (int f = 1; f < m; ++f)
           if (step[f] < step[g]) g = f;
-        if (!affine || !aff[g] || tried[g] || !(step[g] < kInf)) break;
+        if (!aff[g] || tried[g] || !(step[g] < kInf)) break;
         tried[g] = true;
         ++out.bounds;
         safe[g] = affine_step([&](double s) { return fn.affine_bound(g, t, s); }, d0[g], dd0[g],
