@@ -55,6 +55,9 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <numbers>
+
+#include <Eigen/LU>
 
 #include "math/types.hpp"
 #include "shapes/shape.hpp"
@@ -96,6 +99,100 @@ inline double log_root(const Vec3& k, const Vec3& v) {
     if (step <= 2e-16 * std::max(1.0, std::abs(s))) break;
   }
   return s;
+}
+
+// The start of the (2, 2, p) support-point solver (Superquadric::flat_support_point): the root
+// x(K) in [0, 1] of x^p + K x^(2p-2) = 1, K >= 0, fitted once per integer p in 3..16.  Each
+// binade [2^E, 2^(E+1)) of 1 + K is cut into 2^kBits segments by the leading mantissa bits, and
+// on each segment x is the quartic interpolant at 5 Chebyshev nodes of the local coordinate u
+// in [0, 1) (the remaining mantissa bits), so the lookup needs no log or pow: the segment index
+// and u are bit fields of 1 + K.  Beyond kBinades binades x = 2^(-E/(2p-2)) (1 + m)^(-1/(2p-2))
+// to within 1e-9 (the x^p term is then negligible), fitted the same way once and scaled.
+// Measured over every segment (tests/shapes/test_superquadric.cpp): within 6e-8 of the root for
+// every p, worst in the first binade (K < 1); so Halley's first step from it is below the
+// solver's stop (1e-6 x) and the support point costs one evaluation of the polynomial.
+struct FlatStartTable {
+  static constexpr int kBits = 3, kBinades = 56, kCoef = 5;
+  int p = 0;
+  double near[kBinades << kBits][kCoef];
+  double far[1 << kBits][kCoef];
+  double scale[32];  // 2^(-r/(2p-2)), r < 2p - 2 <= 30
+  double guess(double K) const {
+    const double z = 1.0 + K;
+    std::uint64_t bits;
+    std::memcpy(&bits, &z, 8);
+    const int e = static_cast<int>(bits >> 52) - 1023;  // >= 0: z >= 1
+    const int j = static_cast<int>(bits >> (52 - kBits)) & ((1 << kBits) - 1);
+    constexpr std::uint64_t kLow = (std::uint64_t{1} << (52 - kBits)) - 1;
+    const double u = static_cast<double>(bits & kLow) * (1.0 / static_cast<double>(kLow + 1));
+    const double* c = e < kBinades ? near[(e << kBits) + j] : far[j];
+    const double x = c[0] + u * (c[1] + u * (c[2] + u * (c[3] + u * c[4])));
+    if (e < kBinades) return x;
+    const int q = e / (2 * p - 2), r = e - q * (2 * p - 2);
+    return std::ldexp(x * scale[r], -q);
+  }
+};
+inline FlatStartTable make_flat_start_table(int p) {
+  FlatStartTable t;
+  t.p = p;
+  const double a = 1.0 / (2.0 * p - 2.0);
+  constexpr int n = FlatStartTable::kCoef, segs = 1 << FlatStartTable::kBits;
+  Eigen::Matrix<double, n, 1> u;
+  Eigen::Matrix<double, n, n> V;
+  for (int i = 0; i < n; ++i) {
+    u[i] = 0.5 * (1.0 - std::cos(std::numbers::pi * (i + 0.5) / n));
+    for (int k = 0; k < n; ++k) V(i, k) = std::pow(u[i], k);
+  }
+  const Eigen::Matrix<double, n, n> Vinv = V.fullPivLu().inverse();
+  auto root = [p](double K) {  // bisection: G(0) = -1 < 0 <= G(1) = K
+    double lo = 0.0, hi = 1.0;
+    for (int it = 0; it < 200; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      if (!(mid > lo && mid < hi)) break;
+      const double G = std::pow(mid, p) + K * std::pow(mid, 2 * p - 2) - 1.0;
+      (G > 0.0 ? hi : lo) = mid;
+    }
+    return 0.5 * (lo + hi);
+  };
+  Eigen::Matrix<double, n, 1> v, c;
+  for (int E = 0; E < FlatStartTable::kBinades; ++E)
+    for (int j = 0; j < segs; ++j) {
+      for (int i = 0; i < n; ++i)
+        v[i] = root(std::ldexp(1.0 + (j + u[i]) / segs, E) - 1.0);
+      c = Vinv * v;
+      for (int k = 0; k < n; ++k) t.near[E * segs + j][k] = c[k];
+    }
+  for (int j = 0; j < segs; ++j) {
+    for (int i = 0; i < n; ++i) v[i] = std::pow(1.0 + (j + u[i]) / segs, -a);
+    c = Vinv * v;
+    for (int k = 0; k < n; ++k) t.far[j][k] = c[k];
+  }
+  for (int r = 0; r < 32; ++r) t.scale[r] = std::exp2(-r * a);
+  return t;
+}
+template <int P>
+const FlatStartTable& flat_start_table() {
+  static const FlatStartTable t = make_flat_start_table(P);
+  return t;
+}
+inline const FlatStartTable* flat_start_table_for(int p) {
+  switch (p) {
+    case 3: return &flat_start_table<3>();
+    case 4: return &flat_start_table<4>();
+    case 5: return &flat_start_table<5>();
+    case 6: return &flat_start_table<6>();
+    case 7: return &flat_start_table<7>();
+    case 8: return &flat_start_table<8>();
+    case 9: return &flat_start_table<9>();
+    case 10: return &flat_start_table<10>();
+    case 11: return &flat_start_table<11>();
+    case 12: return &flat_start_table<12>();
+    case 13: return &flat_start_table<13>();
+    case 14: return &flat_start_table<14>();
+    case 15: return &flat_start_table<15>();
+    case 16: return &flat_start_table<16>();
+    default: return nullptr;
+  }
 }
 
 }  // namespace sq_detail
@@ -300,6 +397,10 @@ struct Superquadric {
   // One power per axis with e_i > 2, t_i^(e_i-2) (by squaring when e_i is an integer), gives both
   // t_i^e_i and the diagonal's t_i^(2-e_i); the diagonal has the same cap as support_hessian,
   // which the shape tests compare with.
+  // (2, 2, p) bodies with integer p in 3..16: the start of their support-point solver, the
+  // tabulated root of x^p + K x^(2p-2) = 1 (sq_detail::FlatStartTable; the tests bound its error)
+  bool has_flat_guess() const { return flat_table_ != nullptr; }
+  double flat_guess(double K) const { return flat_table_->guess(K); }
   Vec3 support_hessian_forms(const Vec3& d, const Vec3& x, const Vec3& u, const Vec3& v) const {
     const Vec3 e = exponents(), ax = axes();
     const double h = d.dot(x);
@@ -335,6 +436,7 @@ struct Superquadric {
   // flat_support_point for this p (unrolled powers for p <= 16), or null: not (2, 2, p)
   using FlatSolver = bool (Superquadric::*)(const Vec3&, const Vec3&, Vec3&, double&) const;
   FlatSolver flat_ = nullptr;
+  const sq_detail::FlatStartTable* flat_table_ = nullptr;  // p <= 16: the solver's start
   bool equal_q_ = true;
   // t^k for 0 <= k <= 62 by repeated squaring (at most 11 multiplications, no pow)
   static double int_power(double t, int k) {
@@ -370,9 +472,11 @@ struct Superquadric {
     for (int k = 0; k < 3; ++k)
       if (ie_[k] >= 1 && two_[(k + 1) % 3] && two_[(k + 2) % 3]) flat_axis_ = k;
     flat_ = nullptr;
+    flat_table_ = nullptr;
     if (flat_axis_ >= 0) {
       inv_2p_2_ = 1.0 / (2.0 * e[flat_axis_] - 2.0);
       flat_ = flat_solver(ie_[flat_axis_] + 1);
+      flat_table_ = sq_detail::flat_start_table_for(ie_[flat_axis_] + 2);
       flat_i_ = (flat_axis_ + 1) % 3, flat_j_ = (flat_axis_ + 2) % 3;
     }
     equal_q_ = q_[0] == q_[1] && q_[1] == q_[2];
@@ -387,14 +491,12 @@ struct Superquadric {
       g[i] = std::copysign(e[i] / (E * ax[i]) * P.d1[i], x[i]);
     return g;
   }
-  // The Halley start (1 + K)^(-1/(2p-2)): from the bits of 1 + K for p <= 11, single-precision
-  // pow above (measured, both ways, per support point: p = 4 -15 % and p = 8 -8 % with the
-  // bits; p = 16 and 20 +9 % and +14 %: the bits' 0.4 % error costs a Halley step where x0 is
-  // close to the root).
+  // The Halley start: the table's guess for p <= 16, else (1 + K)^(-1/(2p-2)) in single
+  // precision (within a factor 2^(-1/p) of the root; about 2.2 evaluations of G per point).
   template <int PM1>
   double flat_start(double K) const {
-    if constexpr (PM1 > 0 && PM1 <= 10) {
-      return rough_power(1.0 + K, -inv_2p_2_);
+    if constexpr (PM1 > 0) {
+      return flat_guess(K);
     } else {
       if (K < 1e37) return std::pow(static_cast<float>(1.0 + K), -static_cast<float>(inv_2p_2_));
       return std::pow(1.0 + K, -inv_2p_2_);
@@ -406,12 +508,14 @@ struct Superquadric {
   // t_i^2 + t_j^2 + x^p = 1 becomes the polynomial equation
   //     G(x) = x^p + K x^(2p-2) - 1 = 0,     K = (c_i^2 + c_j^2) / c_k^2,
   // convex and increasing on [0, 1], with powers by squaring (unrolled at compile time for
-  // p <= 16: flat_solver picks the instance once per shape).  Start: x0 = (1 + K)^(-1/(2p-2))
-  // (x^(2p-2) <= x^p on [0, 1], so G(x0) >= 0 and the root lies within a factor 2^(-1/p) below),
-  // for p <= 11 taken to 0.4 % from the bits of 1 + K (rough_power: no pow, which cost a fifth
-  // of the solve; Halley comes back from either side of the root), above in single precision;
-  // Halley steps with x-scaled derivatives (about 2.5 evaluations of G per point for directions
-  // uniform on the sphere at p = 8), stopped as in the general solver after a step below 1e-6 x.
+  // p <= 16: flat_solver picks the instance once per shape).  Start (flat_start): for p <= 16
+  // the tabulated root (sq_detail::FlatStartTable, within 6e-8), so the first Halley step is
+  // already below the stop and a point costs one evaluation of G (2.5 from the closed-form
+  // start (1 + K)^(-1/(2p-2)) used before, measured at p = 8 over directions uniform on the
+  // sphere); above p = 16 that closed form (G(x0) >= 0 since x^(2p-2) <= x^p on [0, 1], the root
+  // within a factor 2^(-1/p) below) in single precision.  Halley steps with x-scaled
+  // derivatives (they come back from either side of the root), stopped as in the general solver
+  // after a step below 1e-6 x.
   // Returns false (the caller takes the general path) when d_k = 0 or K is beyond 1e250.
   template <int PM1>  // p - 1 (0: p - 1 read from ie_ at run time)
   bool flat_support_point(const Vec3& d, const Vec3& cc, Vec3& x_out, double& lambda) const {
@@ -473,21 +577,6 @@ struct Superquadric {
     if constexpr (K == 1) return t;
     else if constexpr (K % 2 == 0) { const double h = int_power_of<K / 2>(t); return h * h; }
     else return t * int_power_of<K - 1>(t);
-  }
-  // z^e to 0.4 % for z >= 1 and -1/4 <= e < 0 (measured over z = 1..2^830, p = 3..64):
-  // log2 z from the exponent and mantissa bits of z (log2(1 + m) ~ m + 0.3466 m (1 - m)), then
-  // 2^y from its integer part as exponent bits and 2^f ~ 1 + f - 0.3431 f (1 - f) (both
-  // quadratics match the functions at 0 and 1 and their largest deviation from the chord)
-  static double rough_power(double z, double e) {
-    std::uint64_t bits;
-    std::memcpy(&bits, &z, 8);
-    const double m = static_cast<double>(bits & ((std::uint64_t{1} << 52) - 1)) * 0x1p-52;
-    const double l2 = static_cast<double>(static_cast<int>(bits >> 52) - 1023) + m + 0.3466 * m * (1.0 - m);
-    const double y = e * l2, fl = std::floor(y), f = y - fl;
-    const std::uint64_t eb = static_cast<std::uint64_t>(static_cast<int>(fl) + 1023) << 52;
-    double two_i;
-    std::memcpy(&two_i, &eb, 8);
-    return two_i * (1.0 + f - 0.3431 * f * (1.0 - f));
   }
   // Support point and the multiplier lambda (0 for d = 0).  Solved for y = 1/lambda:
   // G(y) = sum_i (c_i y)^(q_i) - 1 is convex and increasing; started right of the root (G >= 0),
