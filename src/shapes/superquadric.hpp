@@ -56,6 +56,7 @@
 #include <cstring>
 #include <limits>
 #include <numbers>
+#include <utility>
 
 #include <Eigen/LU>
 
@@ -175,26 +176,6 @@ const FlatStartTable& flat_start_table() {
   static const FlatStartTable t = make_flat_start_table(P);
   return t;
 }
-inline const FlatStartTable* flat_start_table_for(int p) {
-  switch (p) {
-    case 3: return &flat_start_table<3>();
-    case 4: return &flat_start_table<4>();
-    case 5: return &flat_start_table<5>();
-    case 6: return &flat_start_table<6>();
-    case 7: return &flat_start_table<7>();
-    case 8: return &flat_start_table<8>();
-    case 9: return &flat_start_table<9>();
-    case 10: return &flat_start_table<10>();
-    case 11: return &flat_start_table<11>();
-    case 12: return &flat_start_table<12>();
-    case 13: return &flat_start_table<13>();
-    case 14: return &flat_start_table<14>();
-    case 15: return &flat_start_table<15>();
-    case 16: return &flat_start_table<16>();
-    default: return nullptr;
-  }
-}
-
 }  // namespace sq_detail
 
 // The fields are set by the constructor, which also caches shape constants (the bounding radius,
@@ -475,8 +456,7 @@ struct Superquadric {
     flat_table_ = nullptr;
     if (flat_axis_ >= 0) {
       inv_2p_2_ = 1.0 / (2.0 * e[flat_axis_] - 2.0);
-      flat_ = flat_solver(ie_[flat_axis_] + 1);
-      flat_table_ = sq_detail::flat_start_table_for(ie_[flat_axis_] + 2);
+      pick_flat_solver(ie_[flat_axis_] + 2);
       flat_i_ = (flat_axis_ + 1) % 3, flat_j_ = (flat_axis_ + 2) % 3;
     }
     equal_q_ = q_[0] == q_[1] && q_[1] == q_[2];
@@ -508,7 +488,7 @@ struct Superquadric {
   // t_i^2 + t_j^2 + x^p = 1 becomes the polynomial equation
   //     G(x) = x^p + K x^(2p-2) - 1 = 0,     K = (c_i^2 + c_j^2) / c_k^2,
   // convex and increasing on [0, 1], with powers by squaring (unrolled at compile time for
-  // p <= 16: flat_solver picks the instance once per shape).  Start (flat_start): for p <= 16
+  // p <= 16: pick_flat_solver picks the instance once per shape).  Start (flat_start): for p <= 16
   // the tabulated root (sq_detail::FlatStartTable, within 6e-8), so the first Halley step is
   // already below the stop and a point costs one evaluation of G (2.5 from the closed-form
   // start (1 + K)^(-1/(2p-2)) used before, measured at p = 8 over directions uniform on the
@@ -553,24 +533,17 @@ struct Superquadric {
     x_out[j] = std::copysign(ax[j] * cc[j] * y, d[j]);
     return true;
   }
-  static FlatSolver flat_solver(int pm1) {
-    switch (pm1) {
-      case 2: return &Superquadric::flat_support_point<2>;
-      case 3: return &Superquadric::flat_support_point<3>;
-      case 4: return &Superquadric::flat_support_point<4>;
-      case 5: return &Superquadric::flat_support_point<5>;
-      case 6: return &Superquadric::flat_support_point<6>;
-      case 7: return &Superquadric::flat_support_point<7>;
-      case 8: return &Superquadric::flat_support_point<8>;
-      case 9: return &Superquadric::flat_support_point<9>;
-      case 10: return &Superquadric::flat_support_point<10>;
-      case 11: return &Superquadric::flat_support_point<11>;
-      case 12: return &Superquadric::flat_support_point<12>;
-      case 13: return &Superquadric::flat_support_point<13>;
-      case 14: return &Superquadric::flat_support_point<14>;
-      case 15: return &Superquadric::flat_support_point<15>;
-      default: return &Superquadric::flat_support_point<0>;
-    }
+  // The solver instance and the start table for p (flat_support_point<p - 1> and the table of
+  // p for p = 3..16; above, the run-time instance and no table), picked once per shape.
+  void pick_flat_solver(int p) {
+    flat_ = &Superquadric::flat_support_point<0>;
+    flat_table_ = nullptr;
+    [&]<int... I>(std::integer_sequence<int, I...>) {
+      ((p == I + 3 ? (flat_ = &Superquadric::flat_support_point<I + 2>,
+                      flat_table_ = &sq_detail::flat_start_table<I + 3>(), 0)
+                   : 0),
+       ...);
+    }(std::make_integer_sequence<int, 14>{});
   }
   template <int K>
   static double int_power_of(double t) {
