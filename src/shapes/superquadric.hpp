@@ -372,16 +372,16 @@ struct Superquadric {
     }
     return H - rx * rx.transpose() / (lambda * W);
   }
+  // (2, 2, p) bodies with integer p in 3..16: the start of their support-point solver, the
+  // tabulated root of x^p + K x^(2p-2) = 1 (sq_detail::FlatStartTable; the tests bound its error)
+  bool has_flat_guess() const { return flat_table_ != nullptr; }
+  double flat_guess(double K) const { return flat_table_->guess(K); }
   // (u^T H u, u^T H v, v^T H v) for H = support_hessian(d), given the support point x =
   // support_point(d): no second root solve and no matrix (contact/axis_gap.hpp).  The multiplier
   // comes from x itself: d_i x_i = lambda e_i t_i^e_i, so lambda = h / sum e_i t_i^e_i (h = d.x).
   // One power per axis with e_i > 2, t_i^(e_i-2) (by squaring when e_i is an integer), gives both
   // t_i^e_i and the diagonal's t_i^(2-e_i); the diagonal has the same cap as support_hessian,
   // which the shape tests compare with.
-  // (2, 2, p) bodies with integer p in 3..16: the start of their support-point solver, the
-  // tabulated root of x^p + K x^(2p-2) = 1 (sq_detail::FlatStartTable; the tests bound its error)
-  bool has_flat_guess() const { return flat_table_ != nullptr; }
-  double flat_guess(double K) const { return flat_table_->guess(K); }
   Vec3 support_hessian_forms(const Vec3& d, const Vec3& x, const Vec3& u, const Vec3& v) const {
     const Vec3 e = exponents(), ax = axes();
     const double h = d.dot(x);
