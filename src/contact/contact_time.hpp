@@ -76,6 +76,10 @@
 //      that just collided and separates), along its normal (there g_n = d, g_n' = d').
 //  Each step leaves g > 0, hence d > 0, behind it, so no contact is skipped; near contact
 //  (d < eps_d and approaching) the rate-bound stepping of step 2 takes over unchanged.
+//  A flat-faced pair left touching and separating by step a (the bound cannot move it: the
+//  support point of a face leaves its middle as soon as the axis tilts) jumps eps_d / K ahead,
+//  where step 2 would take its first sample, and is certified there by a new axis with a
+//  positive gap instead (ContactOptions::leave_jump; Solver::leaving_flat).
 //  `ContactOptions::separating_axis = false` gives the paper's algorithm alone (tests compare).
 //  Initial overlap (d < 0 at the first evaluated time): if the bodies approach (d' < 0) this is a
 //  contact at that time (`hit`, initial_overlap = true); if they separate (just after a
@@ -179,6 +183,10 @@ struct ContactOptions {
   // Axis steps of flat-faced rigid pairs (no curvature bound) on the concave bound of
   // AxisGap::affine_bound instead of first order only (false: first order, the slow twin).
   bool affine_steps = true;
+  // Flat-faced rigid pairs left touching and separating by the affine steps: jump eps_d / K
+  // ahead and certify it by a new axis (Solver::leaving_flat) instead of sampling the distance
+  // (false: the samples, the slow twin).
+  bool leave_jump = true;
   DistanceOptions distance{};
 };
 
@@ -502,6 +510,18 @@ struct Solver {
   Vec3 axis_ma = Vec3::Zero(), axis_mb = Vec3::Zero();  // body-frame axes of the last gap
   double axis_g = kInf, axis_slope = 0.0;  // the last gap and its rate (second-order pairs)
   bool axis_second_order = false;  // curved or affine steps: axis_slope is the exact rate
+  bool axis_affine = false;        // the last leaps were affine steps (a flat-faced rigid pair)
+
+  // A flat-faced pair that the affine steps left touching (gap below eps_d) and separating
+  // (rate > 0; just after its collision): the bound cannot move it, because a face's support
+  // point leaves the face's middle as soon as the axis tilts.  With leave_jump the search then
+  // jumps eps_d / K ahead, where a distance sample would have been taken, and takes a new axis
+  // there: if its gap is positive, it certifies what that sample would have shown (d > 0, no
+  // contact up to there: the pair was separating at lo, so the sampled stepping would not look
+  // for a dip in between either), and the leaps go on from there without any distance solve.
+  bool leaving_flat() const {
+    return o.leave_jump && axis_affine && axis_slope > 0.0 && axis_g < in.eps_d && K > 0.0;
+  }
 
   // The same along the unit vector n from time t0 (gap, rate and curvature bounds:
   // contact/axis_gap.hpp); `at`: the search's support points of n at t0 (no gap evaluation
@@ -552,7 +572,7 @@ struct Solver {
       g = G.value(t, slope, axis_ma, axis_mb);
       ++out.axis_steps;
     }
-    axis_g = g, axis_slope = slope, axis_second_order = G.is_curved();
+    axis_g = g, axis_slope = slope, axis_second_order = G.is_curved(), axis_affine = false;
     return t;
   }
 
@@ -590,7 +610,7 @@ struct Solver {
       g = G.value_and_rate(t, slope, axis_ma, axis_mb, Wa, Wb);
       ++out.axis_steps;
     }
-    axis_g = g, axis_slope = slope, axis_second_order = true;
+    axis_g = g, axis_slope = slope, axis_second_order = true, axis_affine = true;
     return t;
   }
 
@@ -772,6 +792,7 @@ struct Solver {
       // (a pair that cannot meet inside the window costs no distance solve at all).
       // Re-aim the axis, from the last one, where the gap ran low, as long as that makes progress.
       Vec3 axis = Vec3::Zero();
+      double jumped_from = -1.0;  // >= 0: lo moved ahead by a leaving jump, not yet certified
       for (int k = 0; k < 8 && o.separating_axis; ++k) {
         // a gap of K (hi - lo) already rules out any contact in the window
         const double reach = hi < kInf ? (grow ? rate_bound(lo, hi) : K) * (hi - lo) : kInf;
@@ -782,13 +803,24 @@ struct Solver {
                                        k > 0 ? &axis : nullptr, 1e-3 * in.eps_d, o.axis_rel_tol,
                                        &at);
         if (!(n.squaredNorm() > 0.0)) break;
+        if (jumped_from >= 0.0 && !(g0 > 0.0)) {  // the jump is not certified: sample from before it
+          lo = jumped_from;
+          break;
+        }
+        jumped_from = -1.0;
         axis = n;
         if (g0 >= reach) return;  // none
         const double t = advance_on_axis(n, lo, hi, &at);
         if (!(t < hi)) return;  // none
-        if (!(t > lo)) break;
+        if (!(t > lo)) {
+          if (!leaving_flat()) break;
+          jumped_from = lo;
+          lo = std::min(lo + in.eps_d / K, hi);
+          continue;
+        }
         lo = t;
       }
+      if (jumped_from >= 0.0) lo = jumped_from;  // the loop ended on a jump it did not certify
       // The support points along the last axis are close to the closest points: the first
       // distance solve starts from them instead of the cold guess.
       if (o.separating_axis && !warm.valid && axis_ma.squaredNorm() > 0.0) {

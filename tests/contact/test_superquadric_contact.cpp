@@ -81,6 +81,20 @@ struct Counts {
   }
 };
 
+// A fast path's solve c of one pair against its slow twin's c0: the same outcome, and hits at
+// the same time to 1e-9 relative (the largest difference kept in fast.max_rel).  True if both
+// hit.
+bool twin_hits_agree(const ContactResult& c, const ContactResult& c0, Counts& fast,
+                     const std::string& what) {
+  EXPECT_NE(c.status, ContactStatus::failed) << what;
+  EXPECT_EQ(c.status, c0.status) << what;
+  if (c.status != ContactStatus::hit || c0.status != ContactStatus::hit) return false;
+  const double rel = std::abs(c.time - c0.time) / std::max(c0.time, 1e-3);
+  fast.max_rel = std::max(fast.max_rel, rel);
+  EXPECT_LE(rel, 1e-9) << what;
+  return true;
+}
+
 // Translation only (tilt 0, 1e-8, 1e-4, 1e-2 rad), and with spins about the normal (aligned
 // bodies): a hit at gap / v to 1e-9 relative.
 TEST(SuperquadricContact, FaceToFaceHitAtGapOverClosingSpeed) {
@@ -191,12 +205,7 @@ void affine_twin(Rng& r, const Superquadric& a, const SB& b, int n, Counts& fast
     const std::string what = "pair " + std::to_string(k) + (touching ? " touching" : "") +
                              (tops ? " tops" : "") + " t " + std::to_string(c.time) + " vs " +
                              std::to_string(c0.time);
-    EXPECT_NE(c.status, ContactStatus::failed) << what;
-    ASSERT_EQ(c.status, c0.status) << what;
-    if (c.status != ContactStatus::hit) continue;
-    const double rel = std::abs(c.time - c0.time) / std::max(c0.time, 1e-3);
-    fast.max_rel = std::max(fast.max_rel, rel);
-    EXPECT_LE(rel, 1e-9) << what;
+    if (!twin_hits_agree(c, c0, fast, what)) continue;
     if (k % 8 == 0 && !touching) {  // the reference (spherical tops: k even) on a subset
       const ref::RefContact rc = ref::reference_contact_time(a, sa, b, sb, t_max, 1e-6);
       ++refs;
@@ -230,6 +239,51 @@ TEST(SuperquadricContact, AffineAxisStepsAgreeWithFirstOrderSteps) {
   EXPECT_GT(fast.hits, fast.n / 4);  // the flights do meet (and miss: none > 0)
   EXPECT_GT(fast.none, fast.n / 10);
   EXPECT_GT(refs, 5);
+}
+
+// The leaving jump (ContactOptions::leave_jump) against its slow twin, distance samples: flat-
+// faced pairs that start touching and separate, as just after a collision (face to face with
+// spins, and touching at random points), with the closing or passing motion that may bring them
+// back into contact within the window.  Both give the same outcome, and hits at the same time
+// (1e-9 relative); the jump saves distance solves (it is exercised).
+TEST(SuperquadricContact, LeavingJumpAgreesWithDistanceSamples) {
+  Rng r(317);
+  const int n = scaled_count(400, 0.1, 40);
+  Counts fast, slow;
+  for (int k = 0; k < n; ++k) {
+    const double p = k % 3 == 0 ? 4.0 : 8.0;
+    const Superquadric a = body(p, k % 2 == 0 ? 0.5 : 2.0);
+    const Superquadric b = k % 4 == 1 ? Superquadric{0.8, 0.8, 1.6, 2, 2, 8} : a;
+    const double L = std::max(a.bounding_radius(), b.bounding_radius());
+    const bool faces = k % 2 == 0;
+    const Pose pa{r.ball(1.0), faces ? Mat3(Mat3::Identity()) : r.rotation()};
+    const Vec3 u = faces ? Vec3(Vec3::UnitX()) : r.unit();
+    const Mat3 Rb = faces ? Mat3(Mat3::Identity()) : r.rotation();
+    const Pose pb = testing::place_at_distance(a, pa, b, Rb, u, 0.0);
+    const double v = r.uni(0.3, 2.0);
+    const double spin = (k % 5 == 0 ? 0.1 : 3.0) * v / L;
+    BodyState sa{pa.r, Quat(pa.R), r.ball(0.5), r.ball(spin)};
+    BodyState sb{pb.r, Quat(pb.R), sa.v, r.ball(spin)};
+    sb.v += r.uni(0.05, 1.0) * v * u + r.ball(v);  // leaving, and drifting
+    if (k % 7 == 3) {
+      sa.top = Vec3(r.uni(0.2, 1.0), r.uni(0.2, 1.0), r.uni(0.2, 1.0));
+      sb.top = Vec3(r.uni(0.2, 1.0), r.uni(0.2, 1.0), r.uni(0.2, 1.0));
+    }
+    const ContactInput<Superquadric, Superquadric> in{a, b, sa, sb, 0.0, 0.0, 3.0 * L / v, 1e-5};
+    ContactOptions sampled;
+    sampled.leave_jump = false;
+    const ContactResult c = contact_time(in), c0 = contact_time(in, sampled);
+    fast.add(c), slow.add(c0);
+    const std::string what = "pair " + std::to_string(k) + (faces ? " faces" : "") + " t " +
+                             std::to_string(c.time) + " vs " + std::to_string(c0.time);
+    if (!twin_hits_agree(c, c0, fast, what)) continue;
+  }
+  fast.print("jump");
+  slow.print("samples");
+  EXPECT_EQ(fast.failed + slow.failed, 0);
+  EXPECT_GT(fast.hits, 0);  // some come back into contact
+  EXPECT_GT(fast.none, fast.n / 4);
+  EXPECT_LT(fast.distance_evals, slow.distance_evals);  // the jump is taken
 }
 
 }  // namespace
