@@ -806,10 +806,7 @@ struct Solver {
                                        k > 0 ? &axis : nullptr, 1e-3 * in.eps_d, o.axis_rel_tol,
                                        &at);
         if (!(n.squaredNorm() > 0.0)) break;
-        if (jumped_from >= 0.0 && !(g0 > 0.0)) {  // the jump is not certified: sample from before it
-          lo = jumped_from;
-          break;
-        }
+        if (jumped_from >= 0.0 && !(g0 > 0.0)) break;  // the jump is not certified (below)
         jumped_from = -1.0;
         axis = n;
         if (g0 >= reach) return;  // none
@@ -823,7 +820,7 @@ struct Solver {
         }
         lo = t;
       }
-      if (jumped_from >= 0.0) lo = jumped_from;  // the loop ended on a jump it did not certify
+      if (jumped_from >= 0.0) lo = jumped_from;  // an uncertified jump: sample from before it
       // The support points along the last axis are close to the closest points: the first
       // distance solve starts from them instead of the cold guess.
       if (o.separating_axis && !warm.valid && axis_ma.squaredNorm() > 0.0) {

@@ -242,9 +242,9 @@ TEST(SuperquadricContact, AffineAxisStepsAgreeWithFirstOrderSteps) {
 }
 
 // The leaving jump (ContactOptions::leave_jump) against its slow twin, distance samples: flat-
-// faced pairs that start touching and separate, as just after a collision (face to face with
-// spins, and touching at random points), with the closing or passing motion that may bring them
-// back into contact within the window.  Both give the same outcome, and hits at the same time
+// faced pairs that start touching, most of them separating as just after a collision (face to
+// face with spins, and touching at random points), with a drift that brings some back into
+// contact within the window.  Both give the same outcome, and hits at the same time
 // (1e-9 relative); the jump saves distance solves (it is exercised).
 TEST(SuperquadricContact, LeavingJumpAgreesWithDistanceSamples) {
   Rng r(317);
@@ -276,7 +276,7 @@ TEST(SuperquadricContact, LeavingJumpAgreesWithDistanceSamples) {
     fast.add(c), slow.add(c0);
     const std::string what = "pair " + std::to_string(k) + (faces ? " faces" : "") + " t " +
                              std::to_string(c.time) + " vs " + std::to_string(c0.time);
-    if (!twin_hits_agree(c, c0, fast, what)) continue;
+    twin_hits_agree(c, c0, fast, what);
   }
   fast.print("jump");
   slow.print("samples");
