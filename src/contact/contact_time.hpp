@@ -512,18 +512,20 @@ struct Solver {
   bool axis_second_order = false;  // curved or affine steps: axis_slope is the exact rate
   bool axis_affine = false;        // the last leaps were affine steps (a flat-faced rigid pair)
 
-  // A flat-faced pair that the affine steps left touching (gap in [0, eps_d)) and separating
+  // A flat-faced pair that the affine steps left touching (gap in [-1e-12 L, eps_d): the noise
+  // guard of the steps, which count a gap negative at rounding level as touching) and separating
   // (rate > 0; just after its collision): the bound cannot move it, because a face's support
   // point leaves the face's middle as soon as the axis tilts.  With leave_jump the search then
   // jumps eps_d / K ahead, where the sampled stepping would take its first distance sample, and
   // takes a new axis there: if its gap is positive, it certifies what that sample would have
   // shown (d > 0), and the leaps go on from there without any distance solve.  The sampled
   // stepping would not have looked for a dip in between either: it does so only from an
-  // approaching sample, and this pair separates (d >= g >= 0 with g ~ d ~ 0 touching, so
-  // d' >= g' > 0; the gap >= 0 also keeps out the pairs that overlap, which it handles apart).
+  // approaching sample, and this pair separates (d >= g with g ~ d ~ 0 touching, so
+  // d' >= g' > 0).  A gap below the noise guard keeps the samples: such a pair may really
+  // overlap, which the sampled stepping handles apart.
   bool leaving_flat() const {
-    return o.leave_jump && axis_affine && axis_slope > 0.0 && axis_g >= 0.0 && axis_g < in.eps_d &&
-           K > 0.0;
+    return o.leave_jump && axis_affine && axis_slope > 0.0 && axis_g >= -1e-12 * L &&
+           axis_g < in.eps_d && K > 0.0;
   }
 
   // The same along the unit vector n from time t0 (gap, rate and curvature bounds:
