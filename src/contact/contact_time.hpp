@@ -524,9 +524,11 @@ struct Solver {
   // d' >= g' > 0).  A gap below the noise guard keeps the samples: such a pair may really
   // overlap, which the sampled stepping handles apart.
   bool leaving_flat() const {
-    return o.leave_jump && axis_affine && axis_slope > 0.0 && axis_g >= -1e-12 * L &&
+    return o.leave_jump && axis_affine && axis_slope > 0.0 && axis_g >= touching_noise() &&
            axis_g < in.eps_d && K > 0.0;
   }
+  // The axis steps' noise guard: a gap down to this (negative, rounding level) counts as touching.
+  double touching_noise() const { return -1e-12 * L; }
 
   // The same along the unit vector n from time t0 (gap, rate and curvature bounds:
   // contact/axis_gap.hpp); `at`: the search's support points of n at t0 (no gap evaluation
@@ -543,7 +545,7 @@ struct Solver {
     // parabola g + g' dt - M dt^2 / 2 stays positive up to (g' + q) / M. A gap negative at
     // rounding level (-1e-12 L, the solver's noise guard) counts as touching.
     const double floor = G.is_curved() ? 1e-3 * in.eps_d : in.eps_d;
-    const double noise = -1e-12 * L;
+    const double noise = touching_noise();
     double t = t0, slope = 0.0;
     double g;
     if (at) {
@@ -588,7 +590,7 @@ struct Solver {
   template <class Gap>
   [[gnu::noinline]] double advance_affine(const Gap& G, double t0, double hi, const AxisSupport* at) {
     const double floor = 1e-3 * in.eps_d;
-    const double noise = -1e-12 * L;
+    const double noise = touching_noise();
     double t = t0, slope = 0.0;
     Vec3 Wa, Wb;
     double g;
