@@ -10,8 +10,10 @@
 //
 // Rate. d/dt R^T n = -R^T (w x n) (R' = [w]x R), and grad h(m) = p(m), the support point, so
 //     g_n' = n.(v_B - v_A) + p_A.(W_A x m_A) + p_B.(W_B x m_B),   W = R^T w (body frame,
-// constant for a spherical top since R(t) w = w). |R p| <= L gives the bound
-//     |g_n'| <= K_n = |n.(v_B - v_A)| + L_A |w_A x n| + L_B |w_B x n|,
+// constant for a spherical top since R(t) w = w). W x m is normal to m, so only the part of p
+// normal to m counts: |p.(W x m)| <= l |m'| with l the shape's rotation lever (shapes/shape.hpp,
+// rotation_lever; l <= L, an ellipsoid's a_max - a_min), and
+//     |g_n'| <= K_n = |n.(v_B - v_A)| + l_A |w_A x n| + l_B |w_B x n|,
 // constant in time because the rotation about w keeps |w x n(t)|.
 // Curvature. m(t) turns about a fixed body axis at rate |w|: |m'| = |w x n| =: s,
 // |m''| = |w| s. With the support Hessian bounded by the largest principal radius of curvature
@@ -32,8 +34,8 @@
 // Growth (both shapes scaled about their centres by s(t) = s0 + sdot tau, contact_time.hpp):
 // the support functions scale, g = n.(r_B - r_A) - s(t) (h_A + h_B), so
 //     g' = n.dv - sdot (h_A + h_B) + s(t) (p_A.(W_A x m_A) + p_B.(W_B x m_B)),
-//     |g'| <= |n.dv| + |sdot| (L_A + L_B) + s_max (L_A |w_A x n| + L_B |w_B x n|),
-//     |g''| <= 2 |sdot| (L_A |w_A x n| + L_B |w_B x n|) + s_max M_rigid        (s'' = 0),
+//     |g'| <= |n.dv| + |sdot| (L_A + L_B) + s_max (l_A |w_A x n| + l_B |w_B x n|),
+//     |g''| <= 2 |sdot| (l_A |w_A x n| + l_B |w_B x n|) + s_max M_rigid        (s'' = 0),
 // s_max the largest scale over the interval considered (`bounds(s_max)`).
 #pragma once
 #include <cmath>
@@ -91,7 +93,7 @@ class AxisGap {
     const double swa = ta.sw, swb = tb.sw;
     wa_ = a.w.norm(), wb_ = b.w.norm();
     ndv_ = std::abs(n.dot(dv_));
-    rot_ = La * swa + Lb * swb;
+    rot_ = rotation_lever(sa) * swa + rotation_lever(sb) * swb;  // |dh/dt| <= l |m'|
     Lsum_ = La + Lb;
     const double mdd_a = ta.mdd, mdd_b = tb.mdd;  // bounds of |m''| per body
     if constexpr (kMayCurve)

@@ -9,7 +9,10 @@
 //  1. Bounding spheres (radii L_A, L_B, Eq. lalb) give the window in which a contact is
 //     possible: |r_AB(t)| <= L_A + L_B.  Empty window: `none`, without any distance solve.
 //  2. Stepping with the distance-rate bound (Eq. distOver; the rules of contact/first_root.hpp)
-//        |d'(t)| <= K = |v_B - v_A| + |w_A| L_A + |w_B| L_B :
+//        |d'(t)| <= K = |v_B - v_A| + |w_A| l_A + |w_B| l_B :
+//     (l the rotation lever of the shape, shapes/shape.hpp: a closest point x with normal n
+//     moves along n at |n.(w x (x - r))| = |w.((x - r) x n)| <= |w| l, and l <= L, the paper's
+//     bounding radius; an ellipsoid's l is a_max - a_min)
 //     (for a top that is not spherical w changes along the flight: |w| is replaced by its
 //     maximum over the flight, Motion::max_angular_speed; motion/motion.hpp)
 //     from t with distance d, no contact is possible before t + d / K.  Step
@@ -96,7 +99,7 @@
 //     U(x) = v + w x (x - r) + (s'/s) (x - r):
 //   - distance rate d' = n.(U_B(x_B) - U_A(x_A)) (envelope theorem, unchanged form);
 //   - rate bound over [t0, t1]: |x - r| <= L s(t), so
-//        K = |v_B - v_A| + (|w_A| L_A + |w_B| L_B) max(s(t0), s(t1)) + |s'| (L_A + L_B),
+//        K = |v_B - v_A| + (|w_A| l_A + |w_B| l_B) max(s(t0), s(t1)) + |s'| (L_A + L_B),
 //     recomputed per step (s grows): the step dt0 = max(d, eps_d) / K(t, t) is shortened to
 //     dt = max(d, eps_d) / K(t, t + dt0), a valid bound on [t, t + dt] since dt <= dt0;
 //   - contact system: with y = R^T (x - r), z = y / s, dz/dt = -R^T U / s, so
@@ -143,6 +146,7 @@ struct Scaled {
   double volume() const { return base.volume() * s * s * s; }
   double bounding_radius() const { return base.bounding_radius() * s; }
   double inscribed_radius() const { return base.inscribed_radius() * s; }
+  double rotation_lever() const { return hb::rotation_lever(base) * s; }
   Vec3 half_extents() const { return base.half_extents() * s; }
   Vec3 ray_surface(const Vec3& u) const { return base.ray_surface(u) * s; }
 };
@@ -304,21 +308,25 @@ void contact_system(const MovingBody<SA>& A, const MovingBody<SB>& B, const Vec5
   (*J)(4, 4) = ftb;
 }
 
-// Upper bound of |d'(t)| (Eq. distOver) for spherical tops (|w| constant).
-inline double distance_rate_bound(const BodyState& a, double La, const BodyState& b, double Lb) {
-  return (b.v - a.v).norm() + a.w.norm() * La + b.w.norm() * Lb;
+// Upper bound of |d'(t)| (Eq. distOver) for spherical tops (|w| constant). la, lb: the rotation
+// levers of the shapes (shapes/shape.hpp, rotation_lever): a closest point x with normal n
+// moves along n at |n.(w x (x - r))| <= |w| l, so l replaces the paper's bounding radius L
+// (l <= L; an ellipsoid's a_max - a_min, a sphere's 0).
+inline double distance_rate_bound(const BodyState& a, double la, const BodyState& b, double lb) {
+  return (b.v - a.v).norm() + a.w.norm() * la + b.w.norm() * lb;
 }
 // The same for any tops: |w(t)| <= max_angular_speed() (equal to |w| for spherical tops).
-inline double distance_rate_bound(const Motion& a, double La, const Motion& b, double Lb) {
-  return (b.initial().v - a.initial().v).norm() + a.max_angular_speed() * La +
-         b.max_angular_speed() * Lb;
+inline double distance_rate_bound(const Motion& a, double la, const Motion& b, double lb) {
+  return (b.initial().v - a.initial().v).norm() + a.max_angular_speed() * la +
+         b.max_angular_speed() * lb;
 }
 
-// Upper bound of |d'| over [t0, t1] for bodies scaled by law s(t) (growth; see the header).
-inline double distance_rate_bound(const Motion& a, double La, const Motion& b, double Lb,
-                                  double s_max, double sdot) {
+// Upper bound of |d'| over [t0, t1] for bodies scaled by law s(t) (growth; see the header): the
+// levers la, lb for the rotation, the bounding radii La, Lb for the radial swelling.
+inline double distance_rate_bound(const Motion& a, double la, double La, const Motion& b,
+                                  double lb, double Lb, double s_max, double sdot) {
   return (b.initial().v - a.initial().v).norm() +
-         (a.max_angular_speed() * La + b.max_angular_speed() * Lb) * s_max +
+         (a.max_angular_speed() * la + b.max_angular_speed() * lb) * s_max +
          std::abs(sdot) * (La + Lb);
 }
 
@@ -440,15 +448,15 @@ struct Solver {
         L(std::max(i.shape_a.bounding_radius(), i.shape_b.bounding_radius()) *
           (grow ? A.scale_at(i.t_start) : 1.0)),
         K(grow ? rate_bound(i.t_start, i.t_start)
-               : distance_rate_bound(A.motion, i.shape_a.bounding_radius(), B.motion,
-                                     i.shape_b.bounding_radius())),
+               : distance_rate_bound(A.motion, rotation_lever(i.shape_a), B.motion,
+                                     rotation_lever(i.shape_b))),
         warm(i.warm), warm_scale(grow ? A.scale_at(i.t_start) : 1.0) {}
 
   // Rate bound over [t0, t1] (growth: the scale is largest at one end).
   double rate_bound(double t0, double t1) const {
     if (!grow) return K;
-    return distance_rate_bound(A.motion, in.shape_a.bounding_radius(), B.motion,
-                               in.shape_b.bounding_radius(),
+    return distance_rate_bound(A.motion, rotation_lever(in.shape_a), in.shape_a.bounding_radius(),
+                               B.motion, rotation_lever(in.shape_b), in.shape_b.bounding_radius(),
                                std::max(A.scale_at(t0), A.scale_at(t1)), in.growth.rate);
   }
 

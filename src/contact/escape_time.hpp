@@ -15,9 +15,10 @@
 // for a top that is not spherical R(t) and w(t) of motion/motion.hpp, and |w x n| below bounded
 // by max |w(t)|).
 // Its rate: d/dt R^T n = -R^T (w x n), and grad h = p (the support point), so
-//     d_f'(t) = -n.v + (R p).(w x n),   |d_f'| <= K_f = |n.v| + |w x n| L,
-// L the bounding radius (|R p| <= L). This is the paper's Eq. distplover, tightened by using
-// only the part of w normal to the face.
+//     d_f'(t) = -n.v + (R p).(w x n),   |d_f'| <= K_f = |n.v| + |w x n| l,
+// l the shape's rotation lever (shapes/shape.hpp, rotation_lever: |p x m| <= l, and w x n is
+// normal to n). This is the paper's Eq. distplover (which has the bounding radius L >= l),
+// tightened by using only the part of w normal to the face and of p normal to n.
 //
 // Algorithm: the first root of the six d_f by conservative advancement (contact/first_root.hpp:
 // Lipschitz steps max(d_f, eps) / K_f, a grazing search where a hidden dip is possible, brackets
@@ -29,7 +30,7 @@
 // Growth: with scale s(t) = scale + scale_rate (t - t_state) the body is its shape scaled by s(t)
 // about its centre (Lubachevsky–Stillinger starts against walls, locals/planar_walls.hpp):
 // d_f(t) = c - margin - n.r(t) - s(t) h(R(t)^T n), d_f' gains -s' h and its rotational part the
-// factor s(t), and K_f = |n.v| + |w x n| L s_max + |s'| L with s_max the larger scale of the window
+// factor s(t), and K_f = |n.v| + |w x n| l s_max + |s'| L with s_max the larger scale of the window
 // (a growing body needs a finite t_max).
 // Shrunken box: the search runs against the box shrunk by `margin`. A dip that step 3 missed
 // is at most (d0 + d1 - K_f dt) / 2 >= -eps / 2 deep (Lipschitz), so with margin >= eps / 2 the
@@ -90,6 +91,7 @@ struct BoxDistance {
   Mat3 axes;
   Vec3 lim;              // half - margin
   double L;
+  double lever;          // the shape's rotation lever (shapes/shape.hpp): |dh/dt| <= lever |m'|
   Motion motion;         // the rotation (any top; motion/motion.hpp)
   double s0 = 1.0, sdot = 0.0;  // growth: scale s(t) = s0 + sdot (t - t_state)
   double smax = 1.0;            // bound of s(t) over the search window
@@ -103,7 +105,7 @@ struct BoxDistance {
   BoxDistance(const S& s, const BodyState& b, double ts, const Obb& box, double margin,
               double scale = 1.0, double scale_rate = 0.0, double t_end = kInf)
       : shape(s), st(b), t_state(ts), axes(box.axes), lim(box.half.array() - margin),
-        L(s.bounding_radius()), motion(b), s0(scale), sdot(scale_rate),
+        L(s.bounding_radius()), lever(rotation_lever(s)), motion(b), s0(scale), sdot(scale_rate),
         smax(scale_rate > 0.0 ? scale + scale_rate * (t_end - ts) : scale) {
     st.r = b.r - box.centre;
     for (int k = 0; k < 3; ++k) Q[k] = L * turn_bounds(motion, Vec3(axes.col(k))).mdd;
@@ -183,7 +185,7 @@ struct BoxDistance {
   // rigid bodies the affine steps of affine_bound below).
   // With m(t) = R(t)^T u (u the face's axis) and h the support function of the shape at scale 1,
   // d_f = lim_k -+ x_k(t) - s(t) h(+-m(t)) and x_k'' = 0 (free flight), so
-  //     |d_f''| <= 2 |s'| |dh/dt| + s |d^2 h/dt^2|,   |dh/dt| <= L |m'|,
+  //     |d_f''| <= 2 |s'| |dh/dt| + s |d^2 h/dt^2|,   |dh/dt| <= l |m'| (l the lever),
   //     |d^2 h/dt^2| <= rho |m'|^2 + L |m''|
   // (rho the largest principal radius of curvature bounds the support Hessian on tangent
   // vectors, |p| <= L), with |m'| = |w x u| and |m''| = |w| |w x u| for a spherical top (m turns
@@ -194,7 +196,7 @@ struct BoxDistance {
       const double rho = shape.max_curvature_radius();
       if (!std::isfinite(rho) || !std::isfinite(smax)) return kInf;
       const auto [sw, mdd] = turn_bounds(motion, Vec3(axes.col(f >> 1)));
-      return 2.0 * std::abs(sdot) * L * sw + smax * (rho * sw * sw + L * mdd);
+      return 2.0 * std::abs(sdot) * lever * sw + smax * (rho * sw * sw + L * mdd);
     } else {
       return kInf;
     }
@@ -228,7 +230,7 @@ struct BoxDistance {
   double rate_bound(int f) const {
     const Vec3 u = axes.col(f >> 1);
     const double wu = motion.spherical() ? st.w.cross(u).norm() : motion.max_angular_speed();
-    return std::abs(st.v.dot(u)) + wu * L * smax + std::abs(sdot) * L;
+    return std::abs(st.v.dot(u)) + wu * lever * smax + std::abs(sdot) * L;
   }
 };
 

@@ -43,6 +43,11 @@ struct Ellipsoid {
   double volume() const { return 4.0 / 3.0 * kPi * a * b * c; }
   double bounding_radius() const { return std::max({a, b, c}); }
   double inscribed_radius() const { return std::min({a, b, c}); }
+  // max |p x m| over unit m (shapes/shape.hpp, rotation_lever): with weights w_i = m_i^2 and
+  // X = a_i^2 with probability w_i, |p x m|^2 = |p|^2 - h^2 = E[X^2] / E[X] - E[X] = Var X / E X,
+  // whose largest value for X in [a_min^2, a_max^2] is (a_max - a_min)^2 (attained by two
+  // values at the ends of the range).
+  double rotation_lever() const { return std::max({a, b, c}) - std::min({a, b, c}); }
   Vec3 half_extents() const { return Vec3(a, b, c); }
   Vec3 ray_surface(const Vec3& u) const {
     return u / std::sqrt(u.cwiseProduct(u).dot(inv_sq()));
@@ -88,6 +93,7 @@ struct Sphere {
   double volume() const { return 4.0 / 3.0 * kPi * radius * radius * radius; }
   double bounding_radius() const { return radius; }
   double inscribed_radius() const { return radius; }
+  double rotation_lever() const { return 0.0; }  // a support point lies on the line along m
   Vec3 half_extents() const { return Vec3::Constant(radius); }
   Vec3 ray_surface(const Vec3& u) const { return u * (radius / u.norm()); }
 

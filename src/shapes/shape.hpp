@@ -62,6 +62,27 @@ concept SupportIsPointDot = requires { requires S::kSupportIsPointDot; };
 template <class S>
 concept BoundedCurvature = requires { requires S::kBoundedCurvature; };
 
+// The rotation lever of a shape: an upper bound of |x x m| over the surface points x (from the
+// centre) and their outward unit normals m, i.e. of the distance of a support point p(m) from
+// the line through the centre along m. A body turning at angular velocity w moves its support
+// value along a fixed lab direction at the rate |dh/dt| = |p.(W x m)| = |W.(m x p)| <= |w x n| l
+// (m' = m x W is normal to m, so only the part of p normal to m counts), and a surface point
+// with normal n, such as a closest point, moves along n at |n.(w x x)| = |w.(x x n)| <= |w| l.
+// So l, not the bounding radius L, is the lever of rotation in every rate bound of a distance or
+// a gap (contact/contact_time.hpp, contact/axis_gap.hpp, contact/escape_time.hpp). For any
+// shape, |x|^2 = (x.m)^2 + |x x m|^2 with x.m = h(m) >= r_in (the ball of the inscribed radius
+// about the centre lies in the body) and |x| <= L, so l <= sqrt(L^2 - r_in^2); shapes with a
+// closed form declare `rotation_lever()` (ellipsoids: a_max - a_min; spheres: 0).
+template <Shape S>
+double rotation_lever(const S& s) {
+  if constexpr (requires { { s.rotation_lever() } -> std::convertible_to<double>; }) {
+    return s.rotation_lever();
+  } else {
+    const double L = s.bounding_radius(), r = s.inscribed_radius();
+    return std::sqrt(std::max(0.0, (L - r) * (L + r)));
+  }
+}
+
 // Ray-surface intersection for any shape: the root s > 0 of phi(s) = f(s u), |u| = 1, on the
 // bracket [inscribed_radius, bounding_radius] (phi is negative below and positive above).
 // Safeguarded Newton (bisection whenever a Newton step leaves the bracket).  Shapes with a

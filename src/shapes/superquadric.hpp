@@ -286,6 +286,14 @@ struct Superquadric {
   // max |x| over the body (exact, see header) with a 1e-12 relative safety margin.
   double bounding_radius() const { return bounding_radius_; }
   double inscribed_radius() const { return std::min({a, b, c}); }
+  // shapes/shape.hpp: the ellipsoid's a_max - a_min when all exponents are 2, else the generic
+  // sqrt(L^2 - r_in^2).
+  double rotation_lever() const {
+    const double mx = std::max({a, b, c}), mn = std::min({a, b, c});
+    if (two_[0] && two_[1] && two_[2]) return mx - mn;
+    const double L = bounding_radius_;
+    return std::sqrt(std::max(0.0, (L - mn) * (L + mn)));
+  }
   // Largest principal radius of curvature (the axis-gap curvature bound, contact/axis_gap.hpp):
   // a_max^2 / a_min when all exponents are 2 (an ellipsoid); +inf otherwise, since an exponent
   // e_i > 2 flattens the surface where it meets the i-th coordinate plane (zero curvature).

@@ -3,9 +3,11 @@
 // closed-form quadratic forms against it.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <random>
 
 #include "shapes/ellipsoid.hpp"
+#include "shapes/superquadric.hpp"
 #include "shapes/shape.hpp"
 
 namespace hb {
@@ -134,6 +136,48 @@ TEST(Shapes, BoundingAndInscribedRadius) {
     EXPECT_LE(r, 4.0 * (1 + 1e-15));
     EXPECT_GE(r, 0.3 * (1 - 1e-15));
   }
+}
+
+// The rotation lever l (shapes/shape.hpp) bounds |p(m) x m| over unit m, the offset of the
+// support point from the line along m, which every rotational rate bound uses: sampled over
+// random and near-axis directions (where the offset of an ellipsoid peaks: between its longest
+// and shortest axes) for ellipsoids, spheres and superquadrics, it is never exceeded; for
+// ellipsoids it is tight (a_max - a_min is reached to 1e-4), and for any shape at most L.
+template <SupportShape S>
+double largest_offset(const S& s, int samples) {
+  double worst = 0.0;
+  for (int k = 0; k < samples; ++k) {
+    Vec3 m = rand_vec(1.0);
+    if (k % 2) {  // directions in a coordinate plane, where the extremes lie
+      m[k % 3] = 0.0;
+    }
+    if (!(m.norm() > 1e-3)) continue;
+    m.normalize();
+    worst = std::max(worst, s.support_point(m).cross(m).norm());
+  }
+  return worst;
+}
+
+TEST(Shapes, RotationLeverBoundsTheSupportPointOffset) {
+  for (int k = 0; k < 20; ++k) {
+    const Ellipsoid e{uni(0.1, 3.0), uni(0.1, 3.0), uni(0.1, 3.0)};
+    const double l = rotation_lever(e), seen = largest_offset(e, 20000);
+    EXPECT_LE(seen, l * (1 + 1e-12) + 1e-15) << e.a << " " << e.b << " " << e.c;
+    EXPECT_GE(seen, l * (1 - 1e-4)) << e.a << " " << e.b << " " << e.c;
+    EXPECT_LE(l, e.bounding_radius());
+  }
+  EXPECT_EQ(rotation_lever(Ellipsoid{1.0, 0.5, 0.5}), 0.5);
+  EXPECT_EQ(rotation_lever(Sphere{1.3}), 0.0);
+  EXPECT_LE(largest_offset(Sphere{1.3}, 1000), 1e-15);
+  for (const Superquadric& s : {Superquadric{1.0, 0.5, 0.5, 2, 2, 2}, Superquadric{0.5, 0.5, 1.0, 2, 2, 8},
+                                Superquadric{1.0, 1.0, 1.0, 8, 8, 8}, Superquadric{0.3, 1.0, 2.0, 4, 3, 20}}) {
+    const double l = rotation_lever(s), seen = largest_offset(s, 20000);
+    EXPECT_LE(seen, l * (1 + 1e-9)) << s.exponents().transpose();
+    EXPECT_LE(l, s.bounding_radius());
+    std::printf("  superquadric (%g, %g, %g): lever %.4f, largest offset seen %.4f, L %.4f\n",
+                s.exponents()[0], s.exponents()[1], s.exponents()[2], l, seen, s.bounding_radius());
+  }
+  EXPECT_EQ(rotation_lever(Superquadric{1.0, 0.5, 0.5, 2, 2, 2}), 0.5);  // the ellipsoid's
 }
 
 }  // namespace
