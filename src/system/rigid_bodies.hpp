@@ -134,6 +134,11 @@ DistanceResult collision_distance(const SA& sa, const Quat& qa, const Pose& pa, 
   return distance(sa, pa, sb, pb, o);
 }
 
+// The no-op second pre-filter of predict_contacts (below).
+struct NeverClear {
+  bool operator()(const BodyState&, std::uint32_t, const Vec3&, double) const { return false; }
+};
+
 // The prediction loop of the rigid pair models (RigidBodies, RigidMixture): body i (at `now`)
 // against the candidates js (at their images `shifts`, or the minimum image), each window cut at
 // the candidate's horizon, at law_end (where the growth law changes) and, with `trim`, at the
@@ -143,12 +148,16 @@ DistanceResult collision_distance(const SA& sa, const Quat& qa, const Pose& pa, 
 // bounding spheres' sum plus its margin; rigid pairs of one shape only). A candidate whose
 // bounding spheres cannot meet within its window is then rejected here, from its position
 // alone, before its orientation is streamed to `now` and a solver is set up: the same test on
-// the same numbers, so the same result (counted as the prediction it replaces).
-template <class Solve, class Fail>
+// the same numbers, so the same result (counted as the prediction it replaces). A candidate
+// that passes it is offered to clear(a, j, c, horizon) (c = r_j - r_i at `now`): true means no
+// contact in the window, proven without streaming j's orientation (RigidBodies: the gap along
+// the line of centres, clear_along_centres of contact/axis_gap.hpp), so the solver, which would
+// answer none, is not set up.
+template <class Solve, class Fail, class Clear = NeverClear>
 void predict_contacts(const State& s, const Box& box, std::uint32_t i, const std::uint32_t* js,
                       const Vec3* shifts, std::size_t n, double now, const double* horizons,
                       double* out, double law_end, bool trim, SolverStats& stats, Solve&& solve,
-                      Fail&& fail, double window_radius = 0.0) {
+                      Fail&& fail, double window_radius = 0.0, Clear&& clear = Clear{}) {
   if (n > 0) s.prefetch(js[0]);
   const BodyState a = s.body(i);  // body i is at `now`
   double earliest = kInf;
@@ -166,6 +175,10 @@ void predict_contacts(const State& s, const Box& box, std::uint32_t i, const std
       double lo = now, hi = horizon;
       if (!bounding_sphere_window(a, b0, now, window_radius, lo, hi) || !(lo <= hi)) {
         stats.add(ContactResult{});  // the solver's answer to this test: none
+        continue;
+      }
+      if (clear(a, j, Vec3(rb - a.r), horizon)) {
+        stats.add(ContactResult{});  // no contact in the window: the solver's answer
         continue;
       }
     }
@@ -240,6 +253,10 @@ struct RigidBodies {
   // Use the loop's per-pair horizons and stop at the earliest contact found (false: every
   // candidate is solved without any horizon; the slow twin the tests compare against).
   bool trim_horizons = true;
+  // Rule out candidates by the gap along the line of centres before streaming their
+  // orientation (centre_line_clear; false: every candidate that passes the bounding spheres
+  // goes to the solver, the slow twin of the tests).
+  bool centre_line_test = true;
   GrowthLaw law{};  // default: no growth
 
   // Largest centre distance at contact over the run (the final size when growing).
@@ -268,7 +285,21 @@ struct RigidBodies {
               law.growing() ? fmt::format(" (growth scale {:.17g}, rate {:.17g})", sl.s, sl.rate) : "",
               law.growing() ? " at scale 1" : "", reproducer(a, b, horizon - now));
         },
-        sl.active() ? 0.0 : window_radius());
+        sl.active() ? 0.0 : window_radius(),
+        [&](const BodyState& a, std::uint32_t j, const Vec3& c, double horizon) {
+          return centre_line_clear(s, a, j, c, now, horizon);
+        });
+  }
+  // The pre-filter of predict_contacts after the bounding spheres (no growth): body i (state a
+  // at `now`) and candidate j (centre separation c at `now`, orientation at its own time) cannot
+  // touch before `horizon` by the gap along their line of centres (clear_along_centres,
+  // contact/axis_gap.hpp). Spherical tops only (the bound turns B's stored orientation by
+  // |w| (now - t_j)); false when off (centre_line_test, the slow twin) or not decided.
+  bool centre_line_clear(const State& s, const BodyState& a, std::uint32_t j, const Vec3& c,
+                         double now, double horizon) const {
+    return centre_line_test && spherical_top(mass.top()) &&
+           clear_along_centres(shape, a.q, a.w, shape, s.q[j], s.w[j], c, Vec3(s.v[j] - a.v),
+                               now - s.t[j], horizon - now);
   }
   // The radius of contact_time's bounding-sphere test for two bodies of this shape at scale 1
   // (no growth): L_A + L_B plus its margin.

@@ -36,6 +36,25 @@ SpeciesTable one_species(const RigidSystemSpec& spec) {
   return {sp};
 }
 
+// Two simulations from the same start step `events` times side by side: the same event types,
+// times and impulses, then the same positions, orientations and angular velocities, bit for bit.
+template <class SimA, class SimB>
+void expect_same_events(SimA& a, SimB& b, int events) {
+  for (int k = 0; k < events; ++k) {
+    const auto ea = a.step(kInf), eb = b.step(kInf);
+    ASSERT_EQ(ea.type, eb.type) << k;
+    ASSERT_EQ(a.now(), b.now()) << k;
+    ASSERT_EQ(ea.record.J, eb.record.J) << k;
+  }
+  a.synchronize();
+  b.synchronize();
+  for (std::size_t i = 0; i < a.state().size(); ++i) {
+    ASSERT_EQ(a.state().r[i], b.state().r[i]) << i;
+    ASSERT_EQ(a.state().q[i].coeffs(), b.state().q[i].coeffs()) << i;
+    ASSERT_EQ(a.state().w[i], b.state().w[i]) << i;
+  }
+}
+
 // The same lattice start through RigidBodies<Ellipsoid> and RigidMixture: identical events and
 // identical states (bit for bit: the same solver instantiation with the same inputs).
 void check_same_trajectory(const Vec3& inertia) {
@@ -48,18 +67,8 @@ void check_same_trajectory(const Vec3& inertia) {
   Simulation<RigidBodies<Ellipsoid>, CellNeighbors> a(box, st, fast, CellNeighbors(fast.interaction_range()));
   Simulation<RigidMixture, CellNeighbors> b(box, st, generic, CellNeighbors(generic.interaction_range()));
   const double e0 = generic.kinetic_energy(b.state());
-  for (int k = 0; k < 3000; ++k) {
-    const auto ea = a.step(kInf), eb = b.step(kInf);
-    ASSERT_EQ(ea.type, eb.type) << k;
-    ASSERT_EQ(a.now(), b.now()) << k;
-    ASSERT_EQ(ea.record.J, eb.record.J) << k;
-  }
-  a.synchronize();
-  b.synchronize();
-  for (std::size_t i = 0; i < st.size(); ++i) {
-    ASSERT_EQ(a.state().r[i], b.state().r[i]) << i;
-    ASSERT_EQ(a.state().w[i], b.state().w[i]) << i;
-  }
+  expect_same_events(a, b, 3000);
+  if (::testing::Test::HasFatalFailure()) return;
   const double e1 = generic.kinetic_energy(b.state());
   std::printf("  one species, inertia (%g, %g, %g): 3000 events identical, energy drift %.2e\n",
               inertia.x(), inertia.y(), inertia.z(), (e1 - e0) / e0);
@@ -134,6 +143,55 @@ TEST(RigidMixture, PolydisperseBodiesScaleShapeMassAndInertia) {
 
 }  // namespace
 
+namespace {
+
+// Every body of a running simulation of `model` (after 2000 events; the candidates each at their
+// own time) predicted against all the others twice by run(s, box, now, i, js, horizons, out,
+// stats, solve, fail, filtered), with and without a pre-filter of predict_contacts: the answers
+// must be the same bit for bit. horizon(i, j): the window lengths. The tallies of both passes.
+struct PrefilterTally {
+  long solved_with = 0, solved_without = 0, hits = 0;
+  SolverStats with, without;
+};
+template <class Horizon, class Run>
+PrefilterTally compare_prefilter(const RigidSystemSpec& spec, const RigidBodies<Ellipsoid>& model,
+                                 Horizon&& horizon, Run&& run) {
+  Box box;
+  const State st = ellipsoid_start(spec, box);
+  Simulation<RigidBodies<Ellipsoid>, CellNeighbors> sim(box, st, model, CellNeighbors(model.interaction_range()));
+  for (int k = 0; k < 2000; ++k) sim.step(kInf);
+  State s = sim.state();
+  const double now = sim.now();
+  const std::size_t n = s.size();
+  std::vector<std::uint32_t> js(n);
+  std::vector<double> horizons(n), with(n), without(n);
+  PrefilterTally tally;
+  auto fail = [](const BodyState&, const BodyState&, std::uint32_t, double) { return std::string("failed"); };
+  for (std::uint32_t i = 0; i < n; ++i) {
+    s.advance_to(i, now);
+    for (std::uint32_t j = 0; j < n; ++j) js[j] = j, horizons[j] = now + horizon(i, j);
+    auto solve = [&](long& count) {
+      return [&](const BodyState& x, const BodyState& y, std::uint32_t, double h) {
+        ++count;
+        ContactInput<Ellipsoid, Ellipsoid> in{model.shape, model.shape, x, y, now, now, h, model.eps_d};
+        return contact_time(in, model.options);
+      };
+    };
+    run(s, box, now, i, js, horizons, with, tally.with, solve(tally.solved_with), fail, true);
+    run(s, box, now, i, js, horizons, without, tally.without, solve(tally.solved_without), fail, false);
+    for (std::size_t k = 0; k < n; ++k) {
+      if (with[k] != without[k]) {
+        ADD_FAILURE() << "bodies " << i << ", " << k << ": " << with[k] << " against " << without[k];
+        return tally;
+      }
+      tally.hits += with[k] < kInf;
+    }
+  }
+  return tally;
+}
+
+}  // namespace
+
 // The position pre-filter of predict_contacts (the bounding-sphere test of contact_time.hpp run
 // before a candidate's orientation is streamed and a solver set up; RigidBodies passes its
 // radius, RigidMixture does not) against the loop without it: on the bodies of a running
@@ -141,48 +199,67 @@ TEST(RigidMixture, PolydisperseBodiesScaleShapeMassAndInertia) {
 // for bit, every candidate is counted as a prediction, and the filter does reject some.
 TEST(RigidBodies, PositionPrefilterGivesTheSolverAnswers) {
   const RigidSystemSpec spec = ellipsoid_spec(Vec3(0.1, 0.25, 0.22));
+  const RigidBodies<Ellipsoid> model = ellipsoid_model(spec);
+  const double R = model.window_radius();
+  const PrefilterTally t = compare_prefilter(
+      spec, model, [](std::uint32_t i, std::uint32_t j) { return 0.02 * (1 + (i + j) % 7); },
+      [&](const State& s, const Box& box, double now, std::uint32_t i, const auto& js,
+          const auto& horizons, auto& out, SolverStats& stats, auto&& solve, auto&& fail,
+          bool filtered) {
+        predict_contacts(s, box, i, js.data(), nullptr, js.size(), now, horizons.data(), out.data(),
+                         kInf, false, stats, solve, fail, filtered ? R : 0.0);
+      });
+  std::printf("  %llu predictions, %ld solved without the pre-filter, %ld with it, %ld hits\n",
+              static_cast<unsigned long long>(t.with.predictions), t.solved_without, t.solved_with, t.hits);
+  EXPECT_EQ(t.with.predictions, t.without.predictions);
+  EXPECT_EQ(t.with.axis_steps, t.without.axis_steps);
+  EXPECT_EQ(t.with.hits, t.without.hits);
+  EXPECT_LT(t.solved_with, t.solved_without / 2);  // most candidates of a whole box are far away
+  EXPECT_GT(t.solved_with, 0);
+  EXPECT_GT(t.hits, 0);
+}
+
+// The second pre-filter of predict_contacts, the gap along the line of centres with the
+// candidate's stored orientation (RigidBodies::centre_line_clear, clear_along_centres of
+// contact/axis_gap.hpp), against the loop without it: on the bodies of a running simulation of
+// spherical tops (the candidates at their own times, so the bound turns their stored
+// orientations), with windows from short to long (cut at the earliest contact found, as the
+// loop does), every candidate's answer is the same bit for bit and counted alike, and the test
+// does rule candidates out. Then whole runs with and without it give the same events and states
+// bit for bit (the solver answers none wherever it rules out).
+TEST(RigidBodies, CentreLineTestGivesTheSolverAnswers) {
+  RigidSystemSpec spec = ellipsoid_spec(Vec3(0.1, 0.1, 0.1));
+  spec.phi = 0.45;
+  RigidBodies<Ellipsoid> model = ellipsoid_model(spec);
+  RigidBodies<Ellipsoid> plain = model;
+  plain.centre_line_test = false;
+  const double R = model.window_radius();
+  const PrefilterTally t = compare_prefilter(
+      spec, model,
+      [](std::uint32_t i, std::uint32_t j) { return 0.005 * (1 + (i + j) % 11) * (1 + (i + j) % 3); },
+      [&](const State& s, const Box& box, double now, std::uint32_t i, const auto& js,
+          const auto& horizons, auto& out, SolverStats& stats, auto&& solve, auto&& fail,
+          bool filtered) {
+        const RigidBodies<Ellipsoid>& m = filtered ? model : plain;
+        predict_contacts(s, box, i, js.data(), nullptr, js.size(), now, horizons.data(), out.data(),
+                         kInf, true, stats, solve, fail, R,
+                         [&](const BodyState& a, std::uint32_t j, const Vec3& c, double horizon) {
+                           return m.centre_line_clear(s, a, j, c, now, horizon);
+                         });
+      });
+  std::printf("  %llu predictions, %ld solved after the bounding spheres, %ld after the line of "
+              "centres too, %ld hits\n",
+              static_cast<unsigned long long>(t.with.predictions), t.solved_without, t.solved_with, t.hits);
+  EXPECT_EQ(t.with.predictions, t.without.predictions);
+  EXPECT_EQ(t.with.hits, t.without.hits);
+  EXPECT_LT(t.solved_with, t.solved_without);
+  EXPECT_GT(t.solved_with, 0);
+  EXPECT_GT(t.hits, 0);
+
   Box box;
   const State st = ellipsoid_start(spec, box);
-  const RigidBodies<Ellipsoid> model = ellipsoid_model(spec);
-  Simulation<RigidBodies<Ellipsoid>, CellNeighbors> sim(box, st, model, CellNeighbors(model.interaction_range()));
-  for (int k = 0; k < 2000; ++k) sim.step(kInf);
-  State s = sim.state();
-  const double now = sim.now();
-  const double R = model.window_radius();
-  const std::size_t n = s.size();
-  std::vector<std::uint32_t> js(n);
-  std::vector<double> horizons(n), with(n), without(n);
-  long solved_with = 0, solved_without = 0, hits = 0;
-  SolverStats stats_with, stats_without;
-  for (std::uint32_t i = 0; i < n; ++i) {
-    s.advance_to(i, now);
-    for (std::uint32_t j = 0; j < n; ++j) {
-      js[j] = j;
-      horizons[j] = now + 0.02 * (1 + (i + j) % 7);  // windows of several lengths
-    }
-    auto solve = [&](long& count) {
-      return [&](const BodyState& x, const BodyState& y, std::uint32_t, double horizon) {
-        ++count;
-        ContactInput<Ellipsoid, Ellipsoid> in{model.shape, model.shape, x, y, now, now, horizon, model.eps_d};
-        return contact_time(in, model.options);
-      };
-    };
-    auto fail = [](const BodyState&, const BodyState&, std::uint32_t, double) { return std::string("failed"); };
-    predict_contacts(s, box, i, js.data(), nullptr, n, now, horizons.data(), with.data(), kInf, false,
-                     stats_with, solve(solved_with), fail, R);
-    predict_contacts(s, box, i, js.data(), nullptr, n, now, horizons.data(), without.data(), kInf, false,
-                     stats_without, solve(solved_without), fail);
-    for (std::size_t k = 0; k < n; ++k) {
-      ASSERT_EQ(with[k], without[k]) << "bodies " << i << ", " << k;
-      hits += with[k] < kInf;
-    }
-  }
-  std::printf("  %zu bodies: %llu predictions, %ld solved without the pre-filter, %ld with it, %ld hits\n",
-              n, static_cast<unsigned long long>(stats_with.predictions), solved_without, solved_with, hits);
-  EXPECT_EQ(stats_with.predictions, stats_without.predictions);
-  EXPECT_EQ(stats_with.axis_steps, stats_without.axis_steps);
-  EXPECT_EQ(stats_with.hits, stats_without.hits);
-  EXPECT_LT(solved_with, solved_without / 2);  // most candidates of a whole box are far away
-  EXPECT_GT(solved_with, 0);
-  EXPECT_GT(hits, 0);
+  Simulation<RigidBodies<Ellipsoid>, CellNeighbors> a(box, st, model, CellNeighbors(model.interaction_range()));
+  Simulation<RigidBodies<Ellipsoid>, CellNeighbors> b(box, st, plain, CellNeighbors(plain.interaction_range()));
+  expect_same_events(a, b, 3000);
+  EXPECT_LT(a.model().stats.axis_steps, b.model().stats.axis_steps);  // the solver was spared work
 }
