@@ -73,13 +73,15 @@ concept BoundedCurvature = requires { requires S::kBoundedCurvature; };
 // shape, |x|^2 = (x.m)^2 + |x x m|^2 with x.m = h(m) >= r_in (the ball of the inscribed radius
 // about the centre lies in the body) and |x| <= L, so l <= sqrt(L^2 - r_in^2); shapes with a
 // closed form declare `rotation_lever()` (ellipsoids: a_max - a_min; spheres: 0).
+inline double rotation_lever_bound(double L, double r_in) {  // sqrt(L^2 - r_in^2)
+  return std::sqrt(std::max(0.0, (L - r_in) * (L + r_in)));
+}
 template <Shape S>
 double rotation_lever(const S& s) {
   if constexpr (requires { { s.rotation_lever() } -> std::convertible_to<double>; }) {
     return s.rotation_lever();
   } else {
-    const double L = s.bounding_radius(), r = s.inscribed_radius();
-    return std::sqrt(std::max(0.0, (L - r) * (L + r)));
+    return rotation_lever_bound(s.bounding_radius(), s.inscribed_radius());
   }
 }
 

@@ -291,8 +291,7 @@ struct Superquadric {
   double rotation_lever() const {
     const double mx = std::max({a, b, c}), mn = std::min({a, b, c});
     if (two_[0] && two_[1] && two_[2]) return mx - mn;
-    const double L = bounding_radius_;
-    return std::sqrt(std::max(0.0, (L - mn) * (L + mn)));
+    return rotation_lever_bound(bounding_radius_, mn);
   }
   // Largest principal radius of curvature (the axis-gap curvature bound, contact/axis_gap.hpp):
   // a_max^2 / a_min when all exponents are 2 (an ellipsoid); +inf otherwise, since an exponent
