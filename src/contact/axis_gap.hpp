@@ -43,6 +43,7 @@
 #include <concepts>
 
 #include "geometry/segment.hpp"
+#include "math/sin_cos.hpp"
 #include "math/types.hpp"
 #include "motion/free_flight.hpp"
 #include "motion/motion.hpp"
@@ -229,8 +230,8 @@ class AxisGap {
   // n rotated by -|w| tau about the unit axis k (Rodrigues; tau = 0: n itself, no trigonometry)
   Vec3 back(const Vec3& k, double w, double tau) const {
     if (w == 0.0 || tau == 0.0) return n_;
-    const double th = -w * tau, c = std::cos(th), s = std::sin(th);
-    return n_ * c + k.cross(n_) * s + k * (k.dot(n_) * (1.0 - c));
+    const SinCos sc = sin_cos(-w * tau);
+    return n_ * sc.c + k.cross(n_) * sc.s + k * (k.dot(n_) * (1.0 - sc.c));
   }
 
   const SA& sa_;
