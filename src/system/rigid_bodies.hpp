@@ -40,6 +40,7 @@ struct SolverStats {
   std::uint64_t grazing_separations = 0;  // collisions given the minimum separation speed
   std::uint64_t hits = 0;                 // predictions that found a contact
   std::uint64_t hit_distance_evals = 0;   // distance solves inside those
+  std::uint64_t prefiltered = 0;  // predictions answered by predict_contacts' pre-filters, no solver
 
   void add(const ContactResult& r) {
     ++predictions;
@@ -145,19 +146,29 @@ struct NeverClear {
 // earliest contact found so far (later ones are not needed). solve(a, b, j, horizon) runs the
 // pair's contact-time solver; a failed solve throws SolverFailure(fail(a, b, j, horizon)).
 // window_radius > 0: the radius the solver's own first test uses (contact_time.hpp: the
-// bounding spheres' sum plus its margin; rigid pairs of one shape only). A candidate whose
+// bounding spheres' sum plus its margin), a number for one shape (RigidBodies) or radius(j) for
+// candidate j (RigidMixture: at least the solver's radius, see there). A candidate whose
 // bounding spheres cannot meet within its window is then rejected here, from its position
 // alone, before its orientation is streamed to `now` and a solver is set up: the same test on
-// the same numbers, so the same result (counted as the prediction it replaces). A candidate
+// the same numbers (or on a radius no smaller), so the same result (counted as the prediction it
+// replaces, and in stats.prefiltered). A candidate
 // that passes it is offered to clear(a, j, c, horizon) (c = r_j - r_i at `now`): true means no
 // contact in the window, proven without streaming j's orientation (RigidBodies: the gap along
 // the line of centres, clear_along_centres of contact/axis_gap.hpp), so the solver, which would
 // answer none, is not set up.
-template <class Solve, class Fail, class Clear = NeverClear>
+template <class Solve, class Fail, class Radius = double, class Clear = NeverClear>
 void predict_contacts(const State& s, const Box& box, std::uint32_t i, const std::uint32_t* js,
                       const Vec3* shifts, std::size_t n, double now, const double* horizons,
                       double* out, double law_end, bool trim, SolverStats& stats, Solve&& solve,
-                      Fail&& fail, double window_radius = 0.0, Clear&& clear = Clear{}) {
+                      Fail&& fail, const Radius& window_radius = Radius{}, Clear&& clear = Clear{}) {
+  auto radius = [&window_radius](std::uint32_t j) {
+    if constexpr (std::is_arithmetic_v<Radius>) {
+      (void)j;
+      return double(window_radius);
+    } else {
+      return double(window_radius(j));
+    }
+  };
   if (n > 0) s.prefetch(js[0]);
   const BodyState a = s.body(i);  // body i is at `now`
   double earliest = kInf;
@@ -169,16 +180,18 @@ void predict_contacts(const State& s, const Box& box, std::uint32_t i, const std
     if (j == i || !(horizon > now)) continue;
     const Vec3 rj = s.r[j] + s.v[j] * (now - s.t[j]);  // as State::body_at streams it
     const Vec3 rb = shifts ? Vec3(rj + shifts[k]) : Vec3(a.r + box.near_image(rj - a.r));
-    if (window_radius > 0.0) {
+    if (const double R = radius(j); R > 0.0) {
       BodyState b0;
       b0.r = rb, b0.v = s.v[j];
       double lo = now, hi = horizon;
-      if (!bounding_sphere_window(a, b0, now, window_radius, lo, hi) || !(lo <= hi)) {
+      if (!bounding_sphere_window(a, b0, now, R, lo, hi) || !(lo <= hi)) {
         stats.add(ContactResult{});  // the solver's answer to this test: none
+        ++stats.prefiltered;
         continue;
       }
       if (clear(a, j, Vec3(rb - a.r), horizon)) {
         stats.add(ContactResult{});  // no contact in the window: the solver's answer
+        ++stats.prefiltered;
         continue;
       }
     }

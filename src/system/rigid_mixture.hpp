@@ -50,6 +50,10 @@ struct RigidMixture {
   GrowthLaw law{};                     // default: no growth
   mutable SolverStats stats{};
   bool trim_horizons = true;           // as RigidBodies::trim_horizons
+  // Reject candidates whose bounding spheres cannot meet in their window before a solver is set
+  // up (window_radius below; false: every candidate goes to the solver, the slow twin of the
+  // tests).
+  bool position_prefilter = true;
 
   static RigidMixture of(const SpeciesTable& species, double eps_d, GrowthLaw law = {}) {
     RigidMixture m;
@@ -111,7 +115,22 @@ struct RigidMixture {
               "contact-time solver failed for bodies {} and {} at t = {:.17g} (growth scale "
               "{:.17g}, rate {:.17g}); reproducer: {}",
               i, j, now, sl.s, sl.rate, reproducer(sa, a, body_shape(s, j), b, horizon - now));
+        },
+        [&, Li = bounding_radius(sa), off = sl.active() || !position_prefilter](std::uint32_t j) {
+          return off ? 0.0 : window_radius(Li, s, j);
         });
+  }
+  // The radius of predict_contacts' bounding-sphere test for body i (bounding radius Li) and
+  // candidate j: no smaller than the solver's own (contact_time.hpp: L_i + L_j plus its margin,
+  // from the resized shapes), so a pair it rejects is one the solver's first test rejects too.
+  // L_j is taken as the species' radius times scale_j, which is exact for spheres and
+  // ellipsoids; a superquadric's resized radius is found anew by a numerical search (its
+  // farthest point), so L_j carries a relative slack of 1e-6, far above that search's error and
+  // far below anything that would let a pair through that the bounding spheres rule out.
+  double window_radius(double Li, const State& s, std::uint32_t j) const {
+    const double Lj = bounding_radius(shape[s.species[j]]) * s.scale[j];
+    const double slack = 1.0 + 1e-6;
+    return (Li + Lj) * slack + bounding_window_margin(std::max(Li, Lj) * slack, eps_d);
   }
 
   // Body i for the single-body event sources (walls): its shape (scale_i) with the growth.
