@@ -387,31 +387,36 @@ Vec3 separating_axis_at(const SA& sa, const Quat& rot_a, const SB& sb, const Qua
 
 // A test that needs no orientation streamed to `now` (the rigid prediction loop runs it before
 // it streams a candidate's orientation and sets up a solver, system/rigid_bodies.hpp): can
-// bodies A and B, both spherical tops of fixed shape, touch in [now, now + span]? A is at
-// `now` (orientation qa, lab angular velocity wa); B's centre is streamed to `now`
-// (separation c = r_B - r_A) but its orientation qb is the stored one, `age` = now - t_B
-// before; dv = v_B - v_A. Along the line of centres u = c / |c|,
-//     g_u(now) >= |c| - h_A(R_A^T u) - h_B(-R_B(t_B)^T u) - l_B |w_B x u| age,
-// since B's support value along a fixed direction changes at most at l_B |w_B x u| (the rate
-// bound of AxisGap above, l the rotation lever), and g_u falls at most at
-//     K_u = |u.dv| + l_A |w_A x u| + l_B |w_B x u|,
-// so g_u(now) > K_u span keeps g_u, hence the distance, positive over the window: true means
-// no contact there (the answer the contact-time solver would give; false: not decided). The
-// margin 1e-10 (L_A + L_B) covers rounding. This is the solver's first test along the line of
-// centres, which alone rules out 42 % of the candidates that pass the bounding spheres in an
-// ellipsoid fluid (phi = 0.5, X0 = 2, NNL).
+// bodies A and B, of fixed shape, touch in [now, now + span]? A is at `now` (orientation qa,
+// lab angular velocity wa); B's centre is streamed to `now` (separation c = r_B - r_A) but its
+// orientation qb and angular velocity wb are the stored ones, `age` = now - t_B before;
+// dv = v_B - v_A. A support value along a fixed lab direction u changes at most at
+// l |w(t) x u| (the rate bound of AxisGap above, l the rotation lever). For a spherical top w
+// is constant; for any other top w(t) turns, and l |w(t)| <= l wmax bounds the rate instead
+// (wmax the top's largest angular speed, FreeRotation::max_angular_speed; pass wmax < 0 for a
+// spherical top). With these turn rates T_A, T_B and u = c / |c|,
+//     g_u(now) >= |c| - h_A(R_A^T u) - h_B(-R_B(t_B)^T u) - T_B age,
+// and g_u falls at most at K_u = |u.dv| + T_A + T_B, so g_u(now) > K_u span keeps g_u, hence
+// the distance, positive over the window: true means no contact there (the answer the
+// contact-time solver would give; false: not decided). The margin 1e-10 (L_A + L_B) covers
+// rounding. This is the solver's first test along the line of centres, which alone rules out
+// 42 % of the candidates that pass the bounding spheres in an ellipsoid fluid (phi = 0.5,
+// X0 = 2, NNL, spherical tops).
 template <SupportShape SA, SupportShape SB>
 bool clear_along_centres(const SA& sa, const Quat& qa, const Vec3& wa, const SB& sb,
                          const Quat& qb, const Vec3& wb, const Vec3& c, const Vec3& dv,
-                         double age, double span) {
+                         double age, double span, double wmax_a = -1.0, double wmax_b = -1.0) {
   const double cn = c.norm();
   if (!(cn > 0.0) || !(span < kInf)) return false;
   const Vec3 u = c / cn;
-  const double la = rotation_lever(sa), lb = rotation_lever(sb);
-  const double turn_b = lb * wb.cross(u).norm();
+  auto turn = [&u](double lever, const Vec3& w, double wmax) {
+    return wmax < 0.0 ? lever * w.cross(u).norm() : lever * wmax;
+  };
+  const double turn_a = turn(rotation_lever(sa), wa, wmax_a);
+  const double turn_b = turn(rotation_lever(sb), wb, wmax_b);
   const double g = cn - sa.support(qa.conjugate() * u) - sb.support(qb.conjugate() * Vec3(-u)) -
                    turn_b * age;
-  const double Ku = std::abs(u.dot(dv)) + la * wa.cross(u).norm() + turn_b;
+  const double Ku = std::abs(u.dot(dv)) + turn_a + turn_b;
   return g - Ku * span > 1e-10 * (sa.bounding_radius() + sb.bounding_radius());
 }
 

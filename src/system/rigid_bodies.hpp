@@ -140,6 +140,14 @@ struct NeverClear {
   bool operator()(const BodyState&, std::uint32_t, const Vec3&, double) const { return false; }
 };
 
+// The largest angular speed of a body's free rotation for clear_along_centres: -1 for a
+// spherical top (w constant: the test uses w itself), else that of its free rotation (the one
+// the State caches and the solver evaluates).
+inline double max_spin(const BodyState& a) { return a.rot ? a.rot->max_angular_speed() : -1.0; }
+inline double max_spin(const State& s, std::uint32_t j) {
+  return spherical_top(s.top(j)) ? -1.0 : s.free_rotation(j).max_angular_speed();
+}
+
 // The prediction loop of the rigid pair models (RigidBodies, RigidMixture): body i (at `now`)
 // against the candidates js (at their images `shifts`, or the minimum image), each window cut at
 // the candidate's horizon, at law_end (where the growth law changes) and, with `trim`, at the
@@ -306,13 +314,14 @@ struct RigidBodies {
   // The pre-filter of predict_contacts after the bounding spheres (no growth): body i (state a
   // at `now`) and candidate j (centre separation c at `now`, orientation at its own time) cannot
   // touch before `horizon` by the gap along their line of centres (clear_along_centres,
-  // contact/axis_gap.hpp). Spherical tops only (the bound turns B's stored orientation by
-  // |w| (now - t_j)); false when off (centre_line_test, the slow twin) or not decided.
+  // contact/axis_gap.hpp; for tops that are not spherical with their largest angular speeds,
+  // from the free rotation the solver uses); false when off (centre_line_test, the slow twin)
+  // or not decided.
   bool centre_line_clear(const State& s, const BodyState& a, std::uint32_t j, const Vec3& c,
                          double now, double horizon) const {
-    return centre_line_test && spherical_top(mass.top()) &&
+    return centre_line_test &&
            clear_along_centres(shape, a.q, a.w, shape, s.q[j], s.w[j], c, Vec3(s.v[j] - a.v),
-                               now - s.t[j], horizon - now);
+                               now - s.t[j], horizon - now, max_spin(a), max_spin(s, j));
   }
   // The radius of contact_time's bounding-sphere test for two bodies of this shape at scale 1
   // (no growth): L_A + L_B plus its margin.

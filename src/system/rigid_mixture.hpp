@@ -54,6 +54,9 @@ struct RigidMixture {
   // up (window_radius below; false: every candidate goes to the solver, the slow twin of the
   // tests).
   bool position_prefilter = true;
+  // Then rule out candidates by the gap along the line of centres (centre_line_clear; false:
+  // every candidate that passes the bounding spheres goes to the solver, the slow twin).
+  bool centre_line_test = true;
 
   static RigidMixture of(const SpeciesTable& species, double eps_d, GrowthLaw law = {}) {
     RigidMixture m;
@@ -118,7 +121,33 @@ struct RigidMixture {
         },
         [&, Li = bounding_radius(sa), off = sl.active() || !position_prefilter](std::uint32_t j) {
           return off ? 0.0 : window_radius(Li, s, j);
+        },
+        [&](const BodyState& a, std::uint32_t j, const Vec3& c, double horizon) {
+          return centre_line_clear(s, sa, a, j, c, now, horizon);
         });
+  }
+  // The second pre-filter of predict_contacts, RigidBodies::centre_line_clear for unlike pairs
+  // and any tops: body i (shape sa, state a at `now`) and candidate j cannot touch before
+  // `horizon` by the gap along their line of centres (clear_along_centres, contact/axis_gap.hpp),
+  // computed with the shapes the solver gets. A resized superquadric is skipped (its
+  // construction searches its farthest point; the solver builds it anyway if needed).
+  bool centre_line_clear(const State& s, const AnyShape& sa, const BodyState& a,
+                         std::uint32_t j, const Vec3& c, double now, double horizon) const {
+    if (!centre_line_test) return false;
+    const AnyShape& base = shape[s.species[j]];
+    AnyShape scaled;
+    const AnyShape* sb = &base;
+    if (s.scale[j] != 1.0) {
+      if (std::holds_alternative<Superquadric>(base)) return false;
+      scaled = resized(base, s.scale[j]);
+      sb = &scaled;
+    }
+    return std::visit(
+        [&](const auto& A, const auto& B) {
+          return clear_along_centres(A, a.q, a.w, B, s.q[j], s.w[j], c, Vec3(s.v[j] - a.v),
+                                     now - s.t[j], horizon - now, max_spin(a), max_spin(s, j));
+        },
+        sa, *sb);
   }
   // The radius of predict_contacts' bounding-sphere test for body i (bounding radius Li) and
   // candidate j: no smaller than the solver's own (contact_time.hpp: L_i + L_j plus its margin,

@@ -124,6 +124,62 @@ void check_lower_bound(std::uint64_t seed, bool tops) {
 TEST(AxisGap, IsALowerBoundOfTheDistanceAndExactAlongTheNormal) { check_lower_bound(43, false); }
 TEST(AxisGap, AsymmetricTopsLowerBound) { check_lower_bound(71, true); }
 
+// clear_along_centres, the prediction loop's pre-filter, against the gap along the line of
+// centres itself: B's orientation is the one it had `age` before `now`; for sampled times t in
+// the window, g_u(t) (true orientations of both at t) must stay above the test's straight line
+// g_u(now) - K_u (t - now) (its lower bound of g_u(now), from B's old orientation, and its rate
+// bound; spherical tops with w x u, asymmetric tops with their largest angular speed), and the
+// distance at t must be positive wherever the test says clear. Pairs from near contact to 2 apart,
+// windows up to 0.5.
+void check_clear_along_centres(std::uint64_t seed, bool tops) {
+  Rng r(seed);
+  const int n = scaled_count(2000, 0.1);
+  int cleared = 0;
+  double worst = -kInf;
+  for (int k = 0; k < n; ++k) {
+    const Pair p = random_pair(r, r.log_uni(1e-3, 2.0), tops);
+    const Motion ma(p.sa), mb(p.sb);
+    const double age = r.uni(0.0, 0.3), span = r.log_uni(1e-3, 0.5);
+    const Vec3 c = mb.position(age) - ma.position(age);
+    const Vec3 u = c.normalized();
+    Quat qa;
+    Vec3 wa;
+    ma.pose(age, qa, wa);
+    const double wmax_a = tops ? ma.max_angular_speed() : -1.0;
+    const double wmax_b = tops ? mb.max_angular_speed() : -1.0;
+    const Vec3 dv = p.sb.v - p.sa.v;
+    // the test's own lower line, recomputed here from its parts
+    auto turn = [&](double l, const Vec3& w, double wmax) { return wmax < 0.0 ? l * w.cross(u).norm() : l * wmax; };
+    const double la = rotation_lever(p.a), lb = rotation_lever(p.b);
+    const double tb = turn(lb, p.sb.w, wmax_b);
+    const double g0 = c.norm() - p.a.support(qa.conjugate() * u) -
+                      p.b.support(p.sb.q.conjugate() * Vec3(-u)) - tb * age;
+    const double Ku = std::abs(u.dot(dv)) + turn(la, wa, wmax_a) + tb;
+    const bool clear = clear_along_centres(p.a, qa, wa, p.b, p.sb.q, p.sb.w, c, dv, age, span,
+                                           wmax_a, wmax_b);
+    EXPECT_EQ(clear, g0 - Ku * span > 1e-10 * (p.a.bounding_radius() + p.b.bounding_radius()));
+    cleared += clear;
+    for (int m = 0; m <= 20; ++m) {
+      const double t = age + span * m / 20.0;
+      const Vec3 ct = mb.position(t) - ma.position(t);
+      const double gu = u.dot(ct) - p.a.support(ma.orientation(t).conjugate() * u) -
+                        p.b.support(mb.orientation(t).conjugate() * Vec3(-u));
+      worst = std::max(worst, (g0 - Ku * (t - age)) - gu);
+      if (clear && (m % 5 == 0)) EXPECT_GT(reference_distance_at(p, t), 0.0) << k << " " << t;
+    }
+  }
+  std::printf("  %d pairs%s: %d clear, max (line - g_u) %.2e\n", n, tops ? " (asymmetric tops)" : "",
+              cleared, worst);
+  EXPECT_LE(worst, 1e-12);
+  EXPECT_GT(cleared, n / 10);
+  EXPECT_LT(cleared, n);
+}
+
+TEST(AxisGap, ClearAlongCentresIsBelowTheGapAlongThem) { check_clear_along_centres(83, false); }
+TEST(AxisGap, ClearAlongCentresIsBelowTheGapAlongThemForAsymmetricTops) {
+  check_clear_along_centres(89, true);
+}
+
 TEST(AxisGap, SeparatingAxisSearchApproachesTheDistance) {
   Rng r(47);
   const int n = scaled_count(1000, 0.1);

@@ -132,28 +132,47 @@ TEST(RigidMixture, UnlikeShapesAndTopsConserveAndNeverOverlap) {
   EXPECT_EQ(check(sim.state(), sim.box()).overlaps, 0u);
 }
 
-// The position pre-filter of the mixture (RigidMixture::window_radius: each pair's bounding
-// spheres, from the species radius times the body's scale) against the mixture without it, on
-// unlike, polydisperse shapes (superquadrics included, whose resized radius is found by a
-// search of their own): the same 3000 events (900 in Debug) and states bit for bit, the same
-// number of predictions, and the filter does answer some of them without a solver.
-TEST(RigidMixture, PositionPrefilterGivesTheSameRun) {
-  const SpeciesTable sp = unlike_species(true);
+// The pre-filters of the mixture against the mixture without them, on unlike, polydisperse
+// shapes (superquadrics included, whose resized radius is found by a search of their own):
+//  * the bounding spheres (RigidMixture::window_radius: each pair's, from the species radius
+//    times the body's scale), alone and
+//  * with the gap along the line of centres (centre_line_clear), on asymmetric tops, then on
+//    spherical ones.
+// Each gives the same 3000 events (900 in Debug) and states bit for bit, the same number of
+// predictions, and answers some of them without a solver.
+SolverStats compare_mixture_prefilter(const SpeciesTable& sp, bool centre_line) {
   const GrowthResult g = grow_unlike(sp);
-  const RigidMixture m = RigidMixture::of(sp, 1e-5);
+  RigidMixture m = RigidMixture::of(sp, 1e-5);
+  m.centre_line_test = centre_line;
   RigidMixture plain = m;
-  plain.position_prefilter = false;
+  plain.position_prefilter = plain.centre_line_test = false;
   Simulation<RigidMixture, CellNeighbors> a(g.box, g.state, m, CellNeighbors(m.interaction_range()));
   Simulation<RigidMixture, CellNeighbors> b(g.box, g.state, plain, CellNeighbors(plain.interaction_range()));
   expect_same_events(a, b, hb::testing::scaled_count(3000, 0.3));  // 900 events in Debug
   const SolverStats &fa = a.model().stats, &fb = b.model().stats;
-  std::printf("  %llu predictions, %llu of them answered by the pre-filter\n",
+  std::printf("  %llu predictions, %llu of them answered by the pre-filters\n",
               static_cast<unsigned long long>(fa.predictions),
               static_cast<unsigned long long>(fa.prefiltered));
   EXPECT_EQ(fa.predictions, fb.predictions);
   EXPECT_EQ(fa.hits, fb.hits);
   EXPECT_EQ(fb.prefiltered, 0u);
   EXPECT_GT(fa.prefiltered, fa.predictions / 10);
+  return fa;
+}
+
+TEST(RigidMixture, PositionPrefilterGivesTheSameRun) {
+  compare_mixture_prefilter(unlike_species(true), false);
+}
+
+TEST(RigidMixture, CentreLineTestGivesTheSameRun) {
+  SpeciesTable sp = unlike_species(true);  // asymmetric and symmetric tops
+  for (int spherical = 0; spherical < 2; ++spherical) {
+    if (spherical)
+      for (Species& x : sp) x.inertia = Vec3::Constant(x.inertia.x());
+    const SolverStats with = compare_mixture_prefilter(sp, true);
+    const SolverStats spheres_only = compare_mixture_prefilter(sp, false);
+    EXPECT_GT(with.prefiltered, spheres_only.prefiltered);  // the line of centres rules out more
+  }
 }
 
 // Body sizes and masses follow the scale: m s^3, I s^5, and the shape resized by s.
@@ -256,13 +275,14 @@ TEST(RigidBodies, PositionPrefilterGivesTheSolverAnswers) {
 // The second pre-filter of predict_contacts, the gap along the line of centres with the
 // candidate's stored orientation (RigidBodies::centre_line_clear, clear_along_centres of
 // contact/axis_gap.hpp), against the loop without it: on the bodies of a running simulation of
-// spherical tops (the candidates at their own times, so the bound turns their stored
-// orientations), with windows from short to long (cut at the earliest contact found, as the
-// loop does), every candidate's answer is the same bit for bit and counted alike, and the test
-// does rule candidates out. Then whole runs with and without it give the same events and states
+// spherical tops, then of asymmetric tops (whose turn the test bounds by their largest angular
+// speed; the candidates at their own times, so the bound turns their stored orientations), with
+// windows from short to long (cut at the earliest contact found, as the loop does), every
+// candidate's answer is the same bit for bit and counted alike, and the test does rule
+// candidates out. Then whole runs with and without it give the same events and states
 // bit for bit (the solver answers none wherever it rules out).
-TEST(RigidBodies, CentreLineTestGivesTheSolverAnswers) {
-  RigidSystemSpec spec = ellipsoid_spec(Vec3(0.1, 0.1, 0.1));
+void check_centre_line_test(const Vec3& inertia) {
+  RigidSystemSpec spec = ellipsoid_spec(inertia);
   spec.phi = 0.45;
   RigidBodies<Ellipsoid> model = ellipsoid_model(spec);
   RigidBodies<Ellipsoid> plain = model;
@@ -296,4 +316,9 @@ TEST(RigidBodies, CentreLineTestGivesTheSolverAnswers) {
   Simulation<RigidBodies<Ellipsoid>, CellNeighbors> b(box, st, plain, CellNeighbors(plain.interaction_range()));
   expect_same_events(a, b, 3000);
   EXPECT_LT(a.model().stats.axis_steps, b.model().stats.axis_steps);  // the solver was spared work
+}
+
+TEST(RigidBodies, CentreLineTestGivesTheSolverAnswers) { check_centre_line_test(Vec3(0.1, 0.1, 0.1)); }
+TEST(RigidBodies, CentreLineTestGivesTheSolverAnswersForAsymmetricTops) {
+  check_centre_line_test(Vec3(0.1, 0.25, 0.22));
 }
