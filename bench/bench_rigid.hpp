@@ -151,7 +151,7 @@ struct Tally {
   double cpu = 0, wall = 0, collisions = 0, neighbour_events = 0, stale = 0;
   double predictions = 0, distance_evals = 0, distance_nr = 0, axis_steps = 0, axis_bounds = 0, hits = 0,
          hit_distance_evals = 0, grazing = 0, contact_fallbacks = 0, distance_fallbacks = 0,
-         collision_distance_fallbacks = 0;
+         collision_distance_fallbacks = 0, prefiltered = 0, centre_line_clears = 0;
   Tally operator-(const Tally& o) const {
     Tally d;
     d.cpu = cpu - o.cpu, d.wall = wall - o.wall, d.collisions = collisions - o.collisions;
@@ -163,6 +163,8 @@ struct Tally {
     d.grazing = grazing - o.grazing, d.contact_fallbacks = contact_fallbacks - o.contact_fallbacks;
     d.distance_fallbacks = distance_fallbacks - o.distance_fallbacks;
     d.collision_distance_fallbacks = collision_distance_fallbacks - o.collision_distance_fallbacks;
+    d.prefiltered = prefiltered - o.prefiltered;
+    d.centre_line_clears = centre_line_clears - o.centre_line_clears;
     return d;
   }
   Tally& operator+=(const Tally& o) {
@@ -172,6 +174,7 @@ struct Tally {
     hit_distance_evals += o.hit_distance_evals, grazing += o.grazing;
     contact_fallbacks += o.contact_fallbacks, distance_fallbacks += o.distance_fallbacks;
     collision_distance_fallbacks += o.collision_distance_fallbacks;
+    prefiltered += o.prefiltered, centre_line_clears += o.centre_line_clears;
     return *this;
   }
   double fallbacks() const { return contact_fallbacks + distance_fallbacks + collision_distance_fallbacks; }
@@ -199,6 +202,7 @@ Tally tally(const Sim& sim) {
     t.grazing = double(s.grazing_searches), t.contact_fallbacks = double(s.fallbacks);
     t.distance_fallbacks = double(s.distance_fallbacks);
     t.collision_distance_fallbacks = double(s.collision_distance_fallbacks);
+    t.prefiltered = double(s.prefiltered), t.centre_line_clears = double(s.centre_line_clears);
   }
   return t;
 }
@@ -238,6 +242,10 @@ inline void put_costs(Json& j, const Tally& d) {
   j["tau_c_us"] = 1e6 * d.cpu / nc;
   j["collisions_per_second"] = d.collisions / std::max(d.cpu, 1e-12);
   j["predictions_per_collision"] = d.predictions / nc;
+  // of those, answered without a solver: by the bounding spheres or the line of centres
+  // (system/rigid_bodies.hpp predict_contacts), and by the line of centres alone
+  j["prefiltered_per_collision"] = d.prefiltered / nc;
+  j["centre_line_clears_per_collision"] = d.centre_line_clears / nc;
   j["distance_evals_per_prediction"] = d.distance_evals / np;
   j["distance_evals_per_collision"] = d.distance_evals / nc;
   j["distance_nr_iterations_per_eval"] = d.distance_nr / std::max(d.distance_evals, 1.0);
