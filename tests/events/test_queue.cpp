@@ -1,11 +1,13 @@
-// The fast calendar (IndexedHeap) against its brute-force twin: identical pops for the same
-// random set / invalidate / pop sequences, with lazy invalidation by per-particle counters.
+// The fast calendars (IndexedHeap, CalendarQueue) against their brute-force twin: identical
+// pops for the same random set / invalidate / pop sequences, with lazy invalidation by
+// per-particle counters.
 #include <gtest/gtest.h>
 
 #include <pcg_random.hpp>
 #include <random>
 #include <vector>
 
+#include "events/calendar_queue.hpp"
 #include "events/queue.hpp"
 #include "math/types.hpp"
 
@@ -54,10 +56,12 @@ std::vector<Event> drive(std::uint32_t n, std::uint64_t seed, int ops) {
 
 }  // namespace
 
-TEST(Queue, IndexedHeapPopsLikeBruteForce) {
+// Queue Q against the brute-force twin: the same pops, ties included, for the same sequences.
+template <class Q>
+void expect_pops_like_brute_force() {
   for (std::uint32_t n : {1u, 2u, 7u, 64u, 1000u}) {
     for (std::uint64_t seed = 1; seed <= 5; ++seed) {
-      const auto a = drive<IndexedHeap>(n, seed, 20000);
+      const auto a = drive<Q>(n, seed, 20000);
       const auto b = drive<BruteQueue>(n, seed, 20000);
       ASSERT_EQ(a.size(), b.size()) << "n=" << n << " seed=" << seed;
       ASSERT_GT(a.size(), 100u);
@@ -69,6 +73,12 @@ TEST(Queue, IndexedHeapPopsLikeBruteForce) {
     }
   }
 }
+
+TEST(Queue, IndexedHeapPopsLikeBruteForce) { expect_pops_like_brute_force<IndexedHeap>(); }
+
+// The hard-sphere calendar behind the same interface (events/calendar_queue.hpp), the generic
+// loop's queue.
+TEST(Queue, CalendarQueuePopsLikeBruteForce) { expect_pops_like_brute_force<CalendarQueue>(); }
 
 TEST(Queue, PopsInNonDecreasingTimeOrder) {
   const std::uint32_t n = 500;

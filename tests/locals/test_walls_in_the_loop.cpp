@@ -5,6 +5,7 @@
 
 #include <cstdio>
 
+#include "events/calendar_queue.hpp"
 #include "events/queue.hpp"
 #include "locals/planar_walls.hpp"
 #include "neighbors/cell_neighbors.hpp"
@@ -97,7 +98,7 @@ TEST(WallsInTheLoop, UnlikeShapesInAClosedBoxConserveAndStayInside) {
   EXPECT_LE(worst_penetration(m, g.state, g.box), 0.0) << "the grown start is through a wall";
   double drift, pen;
   std::uint64_t walls, overlaps;
-  run_mixture<IndexedHeap>(g, m, 20000, &drift, &pen, &walls, &overlaps);
+  run_mixture<CalendarQueue>(g, m, 20000, &drift, &pen, &walls, &overlaps);
   std::printf("  closed box: %llu wall events, drift %.2e, worst penetration %.3e\n",
               (unsigned long long)walls, drift, pen);
   EXPECT_GT(walls, 500u);
@@ -108,19 +109,24 @@ TEST(WallsInTheLoop, UnlikeShapesInAClosedBoxConserveAndStayInside) {
   EXPECT_EQ(overlaps, 0u);
 }
 
-// The twin: the brute-force queue pops the same events as the indexed heap in a slit.
+// The twins: the brute-force queue and the indexed heap pop the same events as the calendar
+// (the loop's default queue) in a slit.
 TEST(WallsInTheLoop, BruteForceQueueRunsTheSameEvents) {
   const SpeciesTable sp = unlike_species();
   const GrowthResult g = grow_inside(sp, 0.25, 6, Vec3::Ones(), {false, false, true});
   const RigidMixture m = RigidMixture::of(sp, 1e-5);
-  double d1, d2, p1, p2;
-  std::uint64_t w1, w2, o1, o2;
-  const auto a = run_mixture<IndexedHeap>(g, m, 5000, &d1, &p1, &w1, &o1);
+  double d1, d2, d3, p1, p2, p3;
+  std::uint64_t w1, w2, w3, o1, o2, o3;
+  const auto a = run_mixture<CalendarQueue>(g, m, 5000, &d1, &p1, &w1, &o1);
   const auto b = run_mixture<BruteQueue>(g, m, 5000, &d2, &p2, &w2, &o2);
+  const auto c = run_mixture<IndexedHeap>(g, m, 5000, &d3, &p3, &w3, &o3);
   ASSERT_EQ(a.size(), b.size());
+  ASSERT_EQ(a.size(), c.size());
   for (std::size_t k = 0; k < a.size(); ++k) ASSERT_EQ(a[k], b[k]) << k;
+  for (std::size_t k = 0; k < a.size(); ++k) ASSERT_EQ(a[k], c[k]) << k;
   EXPECT_GT(w1, 50u);
   EXPECT_EQ(w1, w2);
+  EXPECT_EQ(w1, w3);
 }
 
 // Hard spheres in a slit (the monomorphic sphere path of the mixture model): the momentum
