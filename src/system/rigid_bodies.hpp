@@ -159,12 +159,11 @@ inline double max_spin(const State& s, std::uint32_t j) {
 // candidate j (RigidMixture: at least the solver's radius, see there). A candidate whose
 // bounding spheres cannot meet within its window is then rejected here, from its position
 // alone, before its orientation is streamed to `now` and a solver is set up: the same test on
-// the same numbers (or on a radius no smaller), so the same result (counted as the prediction it
-// replaces, and in stats.prefiltered). A candidate
-// that passes it is offered to clear(a, j, c, horizon) (c = r_j - r_i at `now`): true means no
-// contact in the window, proven without streaming j's orientation (RigidBodies: the gap along
-// the line of centres, clear_along_centres of contact/axis_gap.hpp), so the solver, which would
-// answer none, is not set up.
+// the same numbers (or on a radius no smaller), so the same result (counted as the prediction
+// it replaces, and in stats.prefiltered). A candidate that passes it is offered to
+// clear(a, j, c, horizon) (c = r_j - r_i at `now`): true means no contact in the window, proven
+// without streaming j's orientation (the gap along the line of centres, clear_along_centres of
+// contact/axis_gap.hpp), so the solver, which would answer none, is not set up.
 template <class Solve, class Fail, class Radius = double, class Clear = NeverClear>
 void predict_contacts(const State& s, const Box& box, std::uint32_t i, const std::uint32_t* js,
                       const Vec3* shifts, std::size_t n, double now, const double* horizons,
