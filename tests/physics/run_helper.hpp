@@ -2,11 +2,14 @@
 #pragma once
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <system_error>
 #include <unistd.h>
+#include <vector>
 
 #include "io/run.hpp"
 
@@ -20,11 +23,32 @@ inline std::filesystem::path test_dir(const std::string& name) {
          ("hardbody-test-" + std::to_string(::getpid()) + "-" + name);
 }
 
+// The scratch directories this process made. They are removed when the process's tests end, if
+// they all passed (ctest runs one test per process); a failed test's run stays for inspection,
+// and HARDBODY_KEEP_TEST_RUNS=1 keeps them all.
+inline std::vector<std::filesystem::path>& scratch_dirs() {
+  static std::vector<std::filesystem::path> dirs;
+  return dirs;
+}
+class ScratchCleanup : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    if (std::getenv("HARDBODY_KEEP_TEST_RUNS") || !::testing::UnitTest::GetInstance()->Passed()) return;
+    for (const auto& d : scratch_dirs()) {
+      std::error_code ec;
+      std::filesystem::remove_all(d, ec);
+    }
+  }
+};
+inline const bool kScratchCleanupRegistered =
+    (::testing::AddGlobalTestEnvironment(new ScratchCleanup), true);
+
 inline nlohmann::json run_config(const std::string& name, const std::string& text,
                                  const std::vector<std::string>& overrides = {}) {
   const auto dir = test_dir(name);
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
+  scratch_dirs().push_back(dir);
   const auto cfg = dir / (name + ".toml");
   std::ofstream(cfg) << text;
   hb::RunOptions opt;
