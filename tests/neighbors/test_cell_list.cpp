@@ -76,8 +76,11 @@ TEST(CellList, CrossingsKeepBinningConsistent) {
     std::set<std::uint32_t> after, fresh;
     cells.for_each_neighbor(i, [&](std::uint32_t j) { after.insert(j); });
     cells.for_each_new_neighbor(i, face, [&](std::uint32_t j) { fresh.insert(j); });
-    for (std::uint32_t j : after)
-      if (!before.count(j)) EXPECT_TRUE(fresh.count(j)) << "body " << j << " not in new layer";
+    for (std::uint32_t j : after) {
+      if (!before.count(j)) {
+        EXPECT_TRUE(fresh.count(j)) << "body " << j << " not in new layer";
+      }
+    }
     // consistency with a fresh binning (position sits on the face it just crossed: allow
     // either adjacent cell along that axis)
     const int k = face >> 1;

@@ -27,6 +27,8 @@ TEST(OverlapCheck, GridAgreesWithAllPairs) {
     const OverlapReport b = sphere_overlaps_grid(r, box, sigma);
     EXPECT_EQ(a.overlaps, b.overlaps) << "rep " << rep;
     EXPECT_DOUBLE_EQ(a.min_distance, b.min_distance) << "rep " << rep;
-    if (rep > 0) EXPECT_GT(a.overlaps, 0u);
+    if (rep > 0) {
+      EXPECT_GT(a.overlaps, 0u);
+    }
   }
 }
