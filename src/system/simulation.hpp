@@ -141,10 +141,10 @@ class Simulation {
   // (kRecheckInCollide) make the same check on the gap their collision's distance solve finds
   // (the gap the pair can close within the tolerance; rigid_bodies.hpp recheck_moved).
   void set_recheck(bool on) { recheck_ = on; }
+  bool recheck() const { return recheck_; }
   // After a collision of i and j, i's prediction leaves j out (predict's `skip`); false: both
   // predict the pair (the slow twin of the tests).
   void set_skip_partner(bool on) { skip_partner_ = on; }
-  bool recheck() const { return recheck_; }
   std::uint64_t collisions() const { return counts_[static_cast<int>(EventType::Collision)]; }
   double next_event_time() const { return queue_.top().time; }
 
