@@ -36,10 +36,10 @@
 #include <vector>
 
 #include "collision/record.hpp"
-#include "events/event.hpp"
-#include "system/body_events.hpp"
 #include "events/calendar_queue.hpp"
+#include "events/event.hpp"
 #include "events/queue.hpp"
+#include "system/body_events.hpp"
 #include "core/box.hpp"
 #include "core/state.hpp"
 
