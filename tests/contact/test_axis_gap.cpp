@@ -165,7 +165,9 @@ void check_clear_along_centres(std::uint64_t seed, bool tops) {
       const double gu = u.dot(ct) - p.a.support(ma.orientation(t).conjugate() * u) -
                         p.b.support(mb.orientation(t).conjugate() * Vec3(-u));
       worst = std::max(worst, (g0 - Ku * (t - age)) - gu);
-      if (clear && (m % 5 == 0)) EXPECT_GT(reference_distance_at(p, t), 0.0) << k << " " << t;
+      if (clear && (m % 5 == 0)) {
+        EXPECT_GT(reference_distance_at(p, t), 0.0) << k << " " << t;
+      }
     }
   }
   std::printf("  %d pairs%s: %d clear, max (line - g_u) %.2e\n", n, tops ? " (asymmetric tops)" : "",
