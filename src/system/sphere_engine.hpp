@@ -40,8 +40,10 @@
 // Collision: collide_spheres (collision/sphere.hpp) with equal masses.
 #pragma once
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -319,14 +321,29 @@ class SphereEngine {
     nb_[std::size_t(i) * kMaxNeighbours + nn] = j;
     p_[i].nn = nn + 1;
   }
-  // i from j's list.  The search compares all kMaxNeighbours slots (a fixed count: the compiler
-  // unrolls it into a few vector compares, with no loop exit to mispredict) and keeps the listed
-  // ones; i is listed (the lists are symmetric).
+  // i from j's list.  The search compares all kMaxNeighbours slots, four at a time (a fixed
+  // count, with no loop exit to mispredict), and keeps the listed ones; i is listed (the lists
+  // are symmetric).  Written with vector types because the compiler left the plain loop scalar
+  // (24 compares, 4.5 % of a run at N = 4000): a shift by k differs per lane, which SSE cannot do.
+  using Lanes = std::uint32_t __attribute__((vector_size(16)));
+  static_assert(kMaxNeighbours % 4 == 0, "the lists are read four slots at a time");
+  static constexpr std::array<std::uint32_t, kMaxNeighbours> kSlotBit = [] {
+    std::array<std::uint32_t, kMaxNeighbours> b{};
+    for (int k = 0; k < kMaxNeighbours; ++k) b[k] = std::uint32_t(1) << k;
+    return b;
+  }();
   void remove(std::uint32_t j, std::uint32_t i) {
     std::uint32_t* l = &nb_[std::size_t(j) * kMaxNeighbours];
     const std::uint32_t nn = p_[j].nn;
-    std::uint32_t found = 0;
-    for (int k = 0; k < kMaxNeighbours; ++k) found |= std::uint32_t(l[k] == i) << k;
+    const Lanes key = {i, i, i, i};
+    Lanes hit = {0, 0, 0, 0};
+    for (int k = 0; k < kMaxNeighbours; k += 4) {
+      Lanes slots, bits;
+      std::memcpy(&slots, l + k, sizeof slots);
+      std::memcpy(&bits, kSlotBit.data() + k, sizeof bits);
+      hit |= static_cast<Lanes>(slots == key) & bits;
+    }
+    std::uint32_t found = hit[0] | hit[1] | hit[2] | hit[3];
     found &= (std::uint32_t(1) << nn) - 1;
     if (found == 0) return;
     const int k = __builtin_ctz(found);
