@@ -48,6 +48,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include "collision/sphere.hpp"
 #include "core/box.hpp"
 #include "core/state.hpp"
@@ -123,7 +125,15 @@ class SphereEngine {
     if (finite > 0 && sum > 0.0) q_.set_width(Calendar::kPerBucket * (sum / finite) / n);
     reorder_every_ = 16 * std::uint64_t(n);
     reorder();
+    prefetch_ = bytes_per_sphere() * n > l2_bytes();
   }
+
+  // Ask for the data of coming events and of neighbours ahead of their use (memory prefetches;
+  // they change no result).  By default on when the engine's arrays outgrow the L2 cache: below
+  // that everything is at hand and the prefetch instructions only cost (measured at N = 4000,
+  // 840 kB against 1 MiB of L2: 2.3 % faster without; at N = 32000 they pay).
+  void set_prefetch(bool on) { prefetch_ = on; }
+  bool prefetch() const { return prefetch_; }
 
   // Re-sort the records along the curve every `events` events (0: never; default 16 N).
   void set_reorder_interval(std::uint64_t events) {
@@ -245,6 +255,7 @@ class SphereEngine {
   // step's work is retiring (they miss at large N).  The partners are the calendar's tags, held
   // in its heap: no load waits on a miss here.
   void prefetch_next() {
+    if (!prefetch_) return;
     q_.prefetch_ahead();
     const std::uint32_t i = q_.top();
     prefetch_event(i, q_.top_tag());
@@ -310,6 +321,12 @@ class SphereEngine {
     }
   }
 
+  // The L2 cache of this machine (1 MiB when the system does not say).
+  static std::size_t l2_bytes() {
+    const long b = sysconf(_SC_LEVEL2_CACHE_SIZE);
+    return b > 0 ? std::size_t(b) : std::size_t(1) << 20;
+  }
+
   [[noreturn]] void push_overflow(std::uint32_t i) const {
     throw std::runtime_error("SphereEngine: more than " + std::to_string(kMaxNeighbours) +
                              " neighbours of sphere " + std::to_string(p_[i].id) +
@@ -355,10 +372,11 @@ class SphereEngine {
   void new_cage(std::uint32_t i) {
     const std::uint32_t* l = &nb_[std::size_t(i) * kMaxNeighbours];
     const std::uint32_t nn = p_[i].nn;
-    for (std::uint32_t k = 0; k < nn; ++k) {  // the lists and counts about to be edited
-      __builtin_prefetch(&nb_[std::size_t(l[k]) * kMaxNeighbours]);
-      __builtin_prefetch(&p_[l[k]]);
-    }
+    if (prefetch_)
+      for (std::uint32_t k = 0; k < nn; ++k) {  // the lists and counts about to be edited
+        __builtin_prefetch(&nb_[std::size_t(l[k]) * kMaxNeighbours]);
+        __builtin_prefetch(&p_[l[k]]);
+      }
     for (std::uint32_t k = 0; k < nn; ++k) remove(l[k], i);
     p_[i].nn = 0;
     const std::uint32_t c_old = cell_of(cage_[i]);
@@ -499,7 +517,8 @@ class SphereEngine {
     const std::uint32_t* l = &nb_[std::size_t(i) * kMaxNeighbours];
     const std::uint32_t nn = a.nn;
     // The neighbours' records are the loads that miss at large N: ask for all of them at once.
-    for (std::uint32_t k = 0; k < nn; ++k) __builtin_prefetch(&p_[l[k]]);
+    if (prefetch_)
+      for (std::uint32_t k = 0; k < nn; ++k) __builtin_prefetch(&p_[l[k]]);
     // Periodic images only near the faces.  A listed j has |c_j - c_i| < sigma + s, and both
     // spheres are inside their cages (radius s / 2) until their events: with c_i more than
     // sigma + 2 s from every face, both positions lie inside the box, so their plain difference
@@ -561,6 +580,7 @@ class SphereEngine {
   std::uint64_t growths_ = 0;
   std::uint64_t collisions_ = 0, cages_ = 0, stale_ = 0;
   std::uint64_t events_ = 0, reorder_every_ = 0, next_reorder_ = 0;
+  bool prefetch_ = true;  // set_prefetch
 };
 
 }  // namespace hb
