@@ -131,7 +131,8 @@ class SphereEngine {
   // Ask for the data of coming events and of neighbours ahead of their use (memory prefetches;
   // they change no result).  By default on when the engine's arrays outgrow the L2 cache: below
   // that everything is at hand and the prefetch instructions only cost (measured at N = 4000,
-  // 840 kB against 1 MiB of L2: 2.3 % faster without; at N = 32000 they pay).
+  // 840 kB against 1 MiB of L2: 2.9 % faster without; at N = 32000 they pay; figures in
+  // docs/benchmarks/README.md).
   void set_prefetch(bool on) { prefetch_ = on; }
   bool prefetch() const { return prefetch_; }
 
