@@ -403,21 +403,27 @@ Vec3 separating_axis_at(const SA& sa, const Quat& rot_a, const SB& sb, const Qua
 // 42 % of the candidates that pass the bounding spheres in an ellipsoid fluid (phi = 0.5,
 // X0 = 2, NNL, spherical tops).
 template <SupportShape SA, SupportShape SB>
-bool clear_along_centres(const SA& sa, const Quat& qa, const Vec3& wa, const SB& sb,
-                         const Quat& qb, const Vec3& wb, const Vec3& c, const Vec3& dv,
-                         double age, double span, double wmax_a = -1.0, double wmax_b = -1.0) {
-  const double cn = c.norm();
-  if (!(cn > 0.0) || !(span < kInf)) return false;
-  const Vec3 u = c / cn;
+bool clear_along_axis(const SA& sa, const Quat& qa, const Vec3& wa, const SB& sb, const Quat& qb,
+                      const Vec3& wb, const Vec3& c, const Vec3& u, const Vec3& dv, double age,
+                      double span, double wmax_a = -1.0, double wmax_b = -1.0) {
+  if (!(span < kInf)) return false;
   auto turn = [&u](double lever, const Vec3& w, double wmax) {
     return wmax < 0.0 ? lever * w.cross(u).norm() : lever * wmax;
   };
   const double turn_a = turn(rotation_lever(sa), wa, wmax_a);
   const double turn_b = turn(rotation_lever(sb), wb, wmax_b);
-  const double g = cn - sa.support(qa.conjugate() * u) - sb.support(qb.conjugate() * Vec3(-u)) -
-                   turn_b * age;
+  const double g = u.dot(c) - sa.support(qa.conjugate() * u) -
+                   sb.support(qb.conjugate() * Vec3(-u)) - turn_b * age;
   const double Ku = std::abs(u.dot(dv)) + turn_a + turn_b;
   return g - Ku * span > 1e-10 * (sa.bounding_radius() + sb.bounding_radius());
+}
+template <SupportShape SA, SupportShape SB>
+bool clear_along_centres(const SA& sa, const Quat& qa, const Vec3& wa, const SB& sb,
+                         const Quat& qb, const Vec3& wb, const Vec3& c, const Vec3& dv,
+                         double age, double span, double wmax_a = -1.0, double wmax_b = -1.0) {
+  const double cn = c.norm();
+  if (!(cn > 0.0)) return false;
+  return clear_along_axis(sa, qa, wa, sb, qb, wb, c, Vec3(c / cn), dv, age, span, wmax_a, wmax_b);
 }
 
 template <SupportShape SA, SupportShape SB>

@@ -169,6 +169,10 @@ struct ContactInput {
   double eps_d = 1e-5;     // the paper's epsilon_d (length units), << min(L_A, L_B)
   DistanceWarmStart warm{};  // previous distance solution of this pair, if any
   ScaleLaw growth{};         // both shapes scaled by s(t) (growth); default: rigid
+  // A lab-frame axis to start the first separating-axis search from (zero: the line of
+  // centres); e.g. the pair's axis of its last solve (ContactResult::axis).  Any unit vector
+  // is a valid start: it only changes how many steps the search takes.
+  Vec3 axis_start = Vec3::Zero();
 };
 
 struct ContactOptions {
@@ -199,6 +203,7 @@ struct ContactResult {
   double time = kInf;
   Vec3 point = Vec3::Zero();    // contact point (lab frame)
   Vec3 normal = Vec3::UnitX();  // unit normal at the contact, from A to B
+  Vec3 axis = Vec3::Zero();     // the last separating axis found (lab frame, A to B; zero: none)
   bool initial_overlap = false;
   double min_distance = kInf;   // smallest distance evaluated (diagnostic)
   long steps = 0;               // rate-bound steps
@@ -408,12 +413,13 @@ inline bool bounding_sphere_window(const BodyState& a, const BodyState& b, doubl
 // converges quadratically on the contact normal, so the guess is close to the closest points;
 // the cold guess (the centre line through the semi-axes) is not, for elongated bodies.
 // `evals` gap evaluations at most; the search stops once the gap is within tol of the distance.
+// `start` (lab frame, A to B), if given, is where the search starts (else the line of centres).
 template <SupportShape SA, SupportShape SB>
 DistanceWarmStart touching_guess(const SA& sa, const Quat& qa, const SB& sb, const Quat& qb,
-                                 const Vec3& c, int evals = 12) {
+                                 const Vec3& c, int evals = 12, const Vec3* start = nullptr) {
   const double tol = 1e-9 * std::max(sa.bounding_radius(), sb.bounding_radius());
   double gap;
-  const Vec3 n = separating_axis_at(sa, qa, sb, qb, c, evals, gap, kInf, 1.0, nullptr, tol, 0.0);
+  const Vec3 n = separating_axis_at(sa, qa, sb, qb, c, evals, gap, kInf, 1.0, start, tol, 0.0);
   if (!(n.squaredNorm() > 0.0)) return DistanceWarmStart{};  // coincident centres: no guess
   return DistanceWarmStart{sa.support_point(qa.conjugate() * n),
                            sb.support_point(-(qb.conjugate() * n)), 1.0, 0.0, true, /*guess=*/true};
@@ -815,9 +821,12 @@ struct Solver {
         AxisSupport at;
         const Vec3 n = separating_axis(in.shape_a, A.motion, in.shape_b, B.motion, lo - in.t_state,
                                        o.axis_evals, g0, reach, grow ? A.scale_at(lo) : 1.0,
-                                       k > 0 ? &axis : nullptr, 1e-3 * in.eps_d, o.axis_rel_tol,
-                                       &at);
+                                       k > 0 ? &axis
+                                             : (in.axis_start.squaredNorm() > 0.0 ? &in.axis_start
+                                                                                  : nullptr),
+                                       1e-3 * in.eps_d, o.axis_rel_tol, &at);
         if (!(n.squaredNorm() > 0.0)) break;
+        out.axis = n;
         if (jumped_from >= 0.0 && !(g0 > 0.0)) break;  // the jump is not certified (below)
         jumped_from = -1.0;
         axis = n;

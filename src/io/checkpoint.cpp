@@ -1,5 +1,7 @@
 #include "io/checkpoint.hpp"
 
+#include <cmath>
+
 #include "io/shape_io.hpp"
 #include "shapes/codec.hpp"
 
@@ -194,6 +196,12 @@ void add_checkpoint_sources(gsd::FrameSource& f, const State& s, LoopSnapshot lo
   for (auto x : loop->counts) l.push_back(double(x));
   l.push_back(double(loop->rescheduled));
   f.log["hardbody/loop"] = record(l);
+  // The pair model's solver memo (rigid bodies: AxisMemo rows x, y, z, j), when it keeps one.
+  if (!loop->memo.empty())
+    f.log["hardbody/solver_memo"] = gsd::row_source<double>(
+        loop->memo.size(), 4, [loop](std::uint64_t k, double* o) {
+          std::copy(loop->memo[k].begin(), loop->memo[k].end(), o);
+        });
   std::vector<double> dr{double(d.phase), d.e0, d.coll0, d.stale0, double(d.log_rows),
                          double(d.frames), d.next_snapshot, d.block_start, d.cpu_prev, d.wall_prev,
                          d.next_corr, d.next_gr, d.rescheduled0};
@@ -332,6 +340,21 @@ void read_core(const Reader& r, Box& box, State& s, LoopSnapshot& loop, DriverSt
   loop.stale = std::uint64_t(l[1]);
   for (int k = 0; k < kEventTypes; ++k) loop.counts[k] = std::uint64_t(l[2 + k]);
   loop.rescheduled = std::uint64_t(l[2 + kEventTypes]);
+  loop.memo.clear();
+  if (auto m = r.f.log.find("hardbody/solver_memo"); m != r.f.log.end()) {
+    const gsd::LogArray& a = m->second;
+    if (a.cols != 4 || n == 0 || a.rows % n != 0)
+      throw InputError(fmt::format("{}: hardbody/solver_memo has {} x {} values, not whole bodies "
+                                   "of 4-value rows", r.path, a.rows, a.cols));
+    loop.memo.resize(a.rows);
+    for (std::size_t k = 0; k < a.rows; ++k) {
+      const double* x = a.values.data() + 4 * k;
+      if (!std::isfinite(x[0]) || !std::isfinite(x[1]) || !std::isfinite(x[2]) || !(x[3] >= 0.0) ||
+          !(x[3] <= 4294967295.0))
+        throw InputError(fmt::format("{}: hardbody/solver_memo row {} is not an axis and a body", r.path, k));
+      loop.memo[k] = {x[0], x[1], x[2], x[3]};
+    }
+  }
   const auto dr = r.row("hardbody/driver");
   if (dr.size() != 13 + kEventTypes) throw InputError(fmt::format("{}: bad driver record", r.path));
   d.phase = int(dr[0]);

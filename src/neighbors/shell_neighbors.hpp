@@ -19,7 +19,11 @@
 namespace hb {
 
 // Symmetric adjacency lists in one flat array with a per-body capacity (no allocation per
-// event; the capacity doubles, for every body at once, on the rare overflow).
+// event; the capacity doubles, for every body at once, on the rare overflow). Each list is kept
+// in index order, so it is a function of its set of neighbours alone, whatever the order of the
+// updates: a list rebuilt from a checkpoint is the very list the run had (a pair model with a
+// memo between solves needs its candidates in one order, simulation.hpp in_index_order), and
+// neighbours numbered along a space-filling curve are read in memory order.
 class AdjacencyLists {
  public:
   void init(std::size_t n, std::uint32_t capacity) {
@@ -32,14 +36,17 @@ class AdjacencyLists {
   const std::uint32_t* end(std::uint32_t i) const { return begin(i) + size_[i]; }
   void add(std::uint32_t i, std::uint32_t j) {
     if (size_[i] == cap_) grow();
-    data_[std::size_t(i) * cap_ + size_[i]++] = j;
+    std::uint32_t* b = data_.data() + std::size_t(i) * cap_;
+    std::uint32_t* p = b + size_[i]++;
+    for (; p > b && p[-1] > j; --p) *p = p[-1];
+    *p = j;
   }
   void remove(std::uint32_t i, std::uint32_t j) {
     std::uint32_t* b = data_.data() + std::size_t(i) * cap_;
     std::uint32_t* e = b + size_[i];
     std::uint32_t* p = std::find(b, e, j);
     if (p == e) throw std::logic_error("neighbour list is not symmetric");
-    *p = *(e - 1);
+    std::copy(p + 1, e, p);
     --size_[i];
   }
   void clear(std::uint32_t i) { size_[i] = 0; }

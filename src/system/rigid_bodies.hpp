@@ -16,6 +16,7 @@
 #include <type_traits>
 
 #include "collision/rigid.hpp"
+#include "contact/axis_memo.hpp"
 #include "contact/contact_time.hpp"
 #include "geometry/distance.hpp"
 #include "motion/growth_law.hpp"
@@ -122,14 +123,16 @@ CollisionContact collision_contact(const BodyState& a, const BodyState& b, const
 // start from the support points of the separating axis (touching_guess, contact_time.hpp)
 // instead of the solver's cold guess: at X0 = 2 it costs half as much (NR+SD iterations
 // 11 -> 3). Without, or if that start does not converge, the solver's own stages run as before.
+// `start` (lab frame, from A to B), if given: where the guess's axis search starts (the pair's
+// memo, contact/axis_memo.hpp) instead of the line of centres.
 template <Shape SA, Shape SB>
 DistanceResult collision_distance(const SA& sa, const Quat& qa, const Pose& pa, const SB& sb,
                                   const Quat& qb, const Pose& pb, const DistanceOptions& o,
-                                  bool guess) {
+                                  bool guess, const Vec3* start = nullptr) {
   if constexpr (SupportShape<SA> && SupportShape<SB> &&
                 !(std::is_same_v<SA, Sphere> && std::is_same_v<SB, Sphere>)) {
     if (guess) {
-      const DistanceWarmStart w = touching_guess(sa, qa, sb, qb, Vec3(pb.r - pa.r));
+      const DistanceWarmStart w = touching_guess(sa, qa, sb, qb, Vec3(pb.r - pa.r), 12, start);
       return distance(sa, pa, sb, pb, o, w.valid ? &w : nullptr);
     }
   }
@@ -147,6 +150,23 @@ struct NeverClear {
 inline double max_spin(const BodyState& a) { return a.rot ? a.rot->max_angular_speed() : -1.0; }
 inline double max_spin(const State& s, std::uint32_t j) {
   return spherical_top(s.top(j)) ? -1.0 : s.free_rotation(j).max_angular_speed();
+}
+
+// The second pre-filter of the rigid models (predict_contacts' `clear`): body i (shape A, state
+// a at `now`) and candidate j (shape B, centre separation c at `now`, orientation at its own
+// time) cannot touch before `horizon` by the gap along their line of centres
+// (clear_along_centres), or else along the pair's last separating axis in the memo
+// (clear_along_axis): any fixed axis gives a valid bound.
+template <class SA, class SB>
+bool clear_along_centres_or_memo(const SA& A, const SB& B, const State& s, std::uint32_t i,
+                                 const BodyState& a, std::uint32_t j, const Vec3& c, double now,
+                                 double horizon, const AxisMemo& memo) {
+  const Vec3 dv = s.v[j] - a.v;
+  const double wa = max_spin(a), wb = max_spin(s, j), age = now - s.t[j], span = horizon - now;
+  if (clear_along_centres(A, a.q, a.w, B, s.q[j], s.w[j], c, dv, age, span, wa, wb)) return true;
+  Vec3 u;
+  return memo.find(i, j, u) &&
+         clear_along_axis(A, a.q, a.w, B, s.q[j], s.w[j], c, Vec3(u.normalized()), dv, age, span, wa, wb);
 }
 
 // The prediction loop of the rigid pair models (RigidBodies, RigidMixture): body i (at `now`)
@@ -279,6 +299,8 @@ struct RigidBodies {
   // goes to the solver, the slow twin of the tests).
   bool centre_line_test = true;
   GrowthLaw law{};  // default: no growth
+  // Each pair's last separating axis (contact/axis_memo.hpp; memo.on = false: the slow twin).
+  mutable AxisMemo memo{};
 
   // Largest centre distance at contact over the run (the final size when growing).
   double interaction_range() const {
@@ -294,10 +316,13 @@ struct RigidBodies {
     const double law_end = now < law.t_stop ? law.t_stop : kInf;  // the law changes there
     predict_contacts(
         s, box, i, js, shifts, n, now, horizons, out, law_end, trim_horizons, stats,
-        [&](const BodyState& a, const BodyState& b, std::uint32_t, double horizon) {
+        [&](const BodyState& a, const BodyState& b, std::uint32_t j, double horizon) {
           ContactInput<S, S> in{shape, shape, a, b, now, now, horizon, eps_d};
           in.growth = sl;
-          return contact_time(in, options);
+          memo.find(i, j, in.axis_start);
+          const ContactResult r = contact_time(in, options);
+          memo.store(s.size(), i, j, r.status == ContactStatus::hit ? r.normal : r.axis);
+          return r;
         },
         [&](const BodyState& a, const BodyState& b, std::uint32_t j, double horizon) {
           return fmt::format(
@@ -308,20 +333,19 @@ struct RigidBodies {
         },
         sl.active() ? 0.0 : window_radius(),
         [&](const BodyState& a, std::uint32_t j, const Vec3& c, double horizon) {
-          return centre_line_clear(s, a, j, c, now, horizon);
+          return centre_line_clear(s, i, a, j, c, now, horizon);
         });
   }
   // The pre-filter of predict_contacts after the bounding spheres (no growth): body i (state a
   // at `now`) and candidate j (centre separation c at `now`, orientation at its own time) cannot
   // touch before `horizon` by the gap along their line of centres (clear_along_centres,
   // contact/axis_gap.hpp; for tops that are not spherical with their largest angular speeds,
-  // from the free rotation the solver uses); false when off (centre_line_test, the slow twin)
+  // from the free rotation the solver uses), then, if that does not decide, by the gap along
+  // the pair's last separating axis (the memo); false when off (centre_line_test, the slow twin)
   // or not decided.
-  bool centre_line_clear(const State& s, const BodyState& a, std::uint32_t j, const Vec3& c,
-                         double now, double horizon) const {
-    return centre_line_test &&
-           clear_along_centres(shape, a.q, a.w, shape, s.q[j], s.w[j], c, Vec3(s.v[j] - a.v),
-                               now - s.t[j], horizon - now, max_spin(a), max_spin(s, j));
+  bool centre_line_clear(const State& s, std::uint32_t i, const BodyState& a, std::uint32_t j,
+                         const Vec3& c, double now, double horizon) const {
+    return centre_line_test && clear_along_centres_or_memo(shape, shape, s, i, a, j, c, now, horizon, memo);
   }
   // The radius of contact_time's bounding-sphere test for two bodies of this shape at scale 1
   // (no growth): L_A + L_B plus its margin.
@@ -343,13 +367,16 @@ struct RigidBodies {
                           double now, double recheck = -1.0) const {
     BodyState a = s.body(i), b = s.body(j);  // both at `now`
     const double sc = law.scale_at(now), sdot = law.rate_at(now);
+    Vec3 start;
+    const Vec3* from = memo.find_either(i, j, start) ? &start : nullptr;
     const auto [r_ab, d] = collision_contact(
         a, b, box, i, j, stats,
         [&](const Pose& pa, const Pose& pb) {
           const bool guess = options.separating_axis;
-          if (sc == 1.0) return collision_distance(shape, a.q, pa, shape, b.q, pb, options.distance, guess);
+          if (sc == 1.0)
+            return collision_distance(shape, a.q, pa, shape, b.q, pb, options.distance, guess, from);
           const auto shp = scaled_shape(shape, sc);
-          return collision_distance(shp, a.q, pa, shp, b.q, pb, options.distance, guess);
+          return collision_distance(shp, a.q, pa, shp, b.q, pb, options.distance, guess, from);
         },
         [&] {
           const std::string js = hb::shape_json(AnyShape(resized(shape, sc)));
@@ -359,6 +386,7 @@ struct RigidBodies {
     const double L = shape.bounding_radius() * sc;
     const double rate = (b.v - a.v).norm() + (a.w.norm() + b.w.norm()) * L + 2.0 * sdot / sc * L;
     if (recheck_moved(d.distance, recheck, rate, 2.0 * L)) return CollisionRecord{.moved = true};
+    memo.store_both(s.size(), i, j, d.normal);
     return collide_separating(s, i, j, a, b, mass, mass, d, r_ab, grow, rate, stats);
   }
 

@@ -57,6 +57,8 @@ struct RigidMixture {
   // Then rule out candidates by the gap along the line of centres (centre_line_clear; false:
   // every candidate that passes the bounding spheres goes to the solver, the slow twin).
   bool centre_line_test = true;
+  // Each pair's last separating axis (contact/axis_memo.hpp; memo.on = false: the slow twin).
+  mutable AxisMemo memo{};
 
   static RigidMixture of(const SpeciesTable& species, double eps_d, GrowthLaw law = {}) {
     RigidMixture m;
@@ -109,7 +111,10 @@ struct RigidMixture {
                 using SB = std::decay_t<decltype(B)>;
                 ContactInput<SA, SB> in{A, B, a, b, now, now, horizon, eps_d};
                 in.growth = sl;
-                return contact_time(in, options);
+                memo.find(i, j, in.axis_start);
+                const ContactResult r = contact_time(in, options);
+                memo.store(s.size(), i, j, r.status == ContactStatus::hit ? r.normal : r.axis);
+                return r;
               },
               sa, body_shape(s, j));
         },
@@ -123,15 +128,16 @@ struct RigidMixture {
           return off ? 0.0 : window_radius(Li, s, j);
         },
         [&](const BodyState& a, std::uint32_t j, const Vec3& c, double horizon) {
-          return centre_line_clear(s, sa, a, j, c, now, horizon);
+          return centre_line_clear(s, i, sa, a, j, c, now, horizon);
         });
   }
   // The second pre-filter of predict_contacts, RigidBodies::centre_line_clear for unlike pairs
   // and any tops: body i (shape sa, state a at `now`) and candidate j cannot touch before
   // `horizon` by the gap along their line of centres (clear_along_centres, contact/axis_gap.hpp),
-  // computed with the shapes the solver gets. A resized superquadric is skipped (its
-  // construction searches its farthest point; the solver builds it anyway if needed).
-  bool centre_line_clear(const State& s, const AnyShape& sa, const BodyState& a,
+  // computed with the shapes the solver gets, then by the gap along the pair's last separating
+  // axis (the memo). A resized superquadric is skipped (its construction searches its farthest
+  // point; the solver builds it anyway if needed).
+  bool centre_line_clear(const State& s, std::uint32_t i, const AnyShape& sa, const BodyState& a,
                          std::uint32_t j, const Vec3& c, double now, double horizon) const {
     if (!centre_line_test) return false;
     const AnyShape& base = shape[s.species[j]];
@@ -144,8 +150,7 @@ struct RigidMixture {
     }
     return std::visit(
         [&](const auto& A, const auto& B) {
-          return clear_along_centres(A, a.q, a.w, B, s.q[j], s.w[j], c, Vec3(s.v[j] - a.v),
-                                     now - s.t[j], horizon - now, max_spin(a), max_spin(s, j));
+          return clear_along_centres_or_memo(A, B, s, i, a, j, c, now, horizon, memo);
         },
         sa, *sb);
   }
@@ -179,15 +184,18 @@ struct RigidMixture {
     BodyState a = s.body(i), b = s.body(j);  // both at `now`
     const double sc = law.scale_at(now), sdot = law.rate_at(now);
     const AnyShape sa = body_shape(s, i), sb = body_shape(s, j);
+    Vec3 start;
+    const Vec3* from = memo.find_either(i, j, start) ? &start : nullptr;
     const auto [r_ab, d] = collision_contact(
         a, b, box, i, j, stats,
         [&](const Pose& pa, const Pose& pb) {
           return std::visit(
               [&](const auto& A, const auto& B) {
                 const bool guess = options.separating_axis;
-                if (sc == 1.0) return collision_distance(A, a.q, pa, B, b.q, pb, options.distance, guess);
+                if (sc == 1.0)
+                  return collision_distance(A, a.q, pa, B, b.q, pb, options.distance, guess, from);
                 return collision_distance(resized(A, sc), a.q, pa, resized(B, sc), b.q, pb,
-                                          options.distance, guess);
+                                          options.distance, guess, from);
               },
               sa, sb);
         },
@@ -199,6 +207,7 @@ struct RigidMixture {
     const double rate = (b.v - a.v).norm() + a.w.norm() * La + b.w.norm() * Lb +
                         (sdot / sc) * (La + Lb);
     if (recheck_moved(d.distance, recheck, rate, La + Lb)) return CollisionRecord{.moved = true};
+    memo.store_both(s.size(), i, j, d.normal);
     return collide_separating(s, i, j, a, b, body_mass(s, i), body_mass(s, j), d, r_ab, grow,
                               rate, stats);
   }

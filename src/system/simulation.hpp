@@ -55,7 +55,22 @@ struct LoopSnapshot {
   std::array<std::uint64_t, kEventTypes> counts{};
   std::uint64_t stale = 0;
   std::uint64_t rescheduled = 0;
+  // The pair model's memory between solves, if it has one (the rigid models' AxisMemo rows,
+  // contact/axis_memo.hpp): it steers the solvers' paths, so a bit-for-bit resume needs it.
+  std::vector<std::array<double, 4>> memo;
 };
+
+// The pair model's memo for a LoopSnapshot (empty if the model keeps none), and back.
+template <class Model>
+std::vector<std::array<double, 4>> model_memo(const Model& m) {
+  if constexpr (requires { m.memo.rows(); }) return m.memo.rows();
+  else return {};
+}
+template <class Model>
+void restore_model_memo(Model& m, const std::vector<std::array<double, 4>>& rows) {
+  if constexpr (requires { m.memo.restore(rows); }) m.memo.restore(rows);
+  else if (!rows.empty()) throw std::invalid_argument("snapshot has a solver memo this model does not keep");
+}
 
 struct StepInfo {
   EventType type = EventType::None;  // None: the time limit was reached
@@ -108,6 +123,7 @@ class Simulation {
       throw std::invalid_argument("snapshot does not match the number of bodies");
     queue_.reset(static_cast<std::uint32_t>(n));
     for (const Event& e : snap.slot) queue_.set(e);
+    restore_model_memo(model_, snap.memo);
   }
   LoopSnapshot snapshot() const {
     LoopSnapshot s;
@@ -118,6 +134,7 @@ class Simulation {
     s.counts = counts_;
     s.stale = stale_;
     s.rescheduled = rescheduled_;
+    s.memo = model_memo(model_);
     return s;
   }
 
@@ -259,6 +276,26 @@ class Simulation {
     if (events_.active() && !with_bodies())
       throw std::invalid_argument("this pair model cannot meet walls (no visit_body)");
   }
+  // A model with a memo between solves (rigid models: AxisMemo) remembers what each solve
+  // found, and which candidates a prediction solves, and with what window, depends on the order
+  // it meets them (the windows shrink to the earliest contact found so far). That order comes
+  // from the neighbour structure's history (list swaps, cell insertions), which a restored
+  // structure does not repeat. In index order, the memo, and so every later solve, is the same
+  // after a resume.
+  static constexpr bool keeps_memo() { return requires(const Model& m) { m.memo.rows(); }; }
+  // Candidates (and their image shifts) sorted by index, images of one body kept in their order:
+  // an insertion sort (a few tens of candidates; neighbour lists come sorted already,
+  // AdjacencyLists, and then it only checks).
+  void in_index_order() {
+    for (std::size_t k = 1; k < cand_.size(); ++k) {
+      const std::uint32_t j = cand_[k];
+      if (!(j < cand_[k - 1])) continue;
+      const Vec3 sh = shift_[k];
+      std::size_t m = k;
+      for (; m > 0 && j < cand_[m - 1]; --m) cand_[m] = cand_[m - 1], shift_[m] = shift_[m - 1];
+      cand_[m] = j, shift_[m] = sh;
+    }
+  }
   static constexpr bool windowed() {
     if constexpr (requires { Model::kWindowed; }) return Model::kWindowed;
     else return false;
@@ -294,6 +331,7 @@ class Simulation {
   }
   // Predict body i against the candidates in cand_ and keep the earliest in `best`.
   void consider(std::uint32_t i, Event& best, double horizon = kInf) {
+    if constexpr (keeps_memo() && !requires { Neighbors::kIndexOrder; }) in_index_order();
     const std::size_t n = cand_.size();
     if (times_.size() < n) times_.resize(2 * n), limits_.resize(2 * n);
     const double* limits = nullptr;

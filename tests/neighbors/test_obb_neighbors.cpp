@@ -106,14 +106,18 @@ TEST(ObbNeighbors, RandomRebuildsKeepListsEqualToBruteForce) {
     EXPECT_LT((s.r[i] + s.image[i].cast<double>().cwiseProduct(box.L) - unwrapped[i]).norm(), 1e-12);
     EXPECT_EQ(nb.box_of(i).centre, s.r[i]);
   }
-  // restore from a snapshot rebuilds the same lists and boxes
+  // restore from a snapshot rebuilds the same lists and boxes; the lists, kept in index order
+  // through 5000 rebuilds, are the same sequences (what a model with a memo between solves
+  // needs for a bit-for-bit resume, system/simulation.hpp in_index_order)
   ObbNeighbors<Ellipsoid> nb2(e, 0.2);
   nb2.restore(box, s, nb.snapshot());
   for (std::uint32_t i = 0; i < n; ++i) {
     EXPECT_EQ(nb2.box_of(i).axes, nb.box_of(i).axes);
-    std::set<std::uint32_t> a(nb.lists().begin(i), nb.lists().end(i));
-    std::set<std::uint32_t> b(nb2.lists().begin(i), nb2.lists().end(i));
+    const std::vector<std::uint32_t> a(nb.lists().begin(i), nb.lists().end(i));
+    const std::vector<std::uint32_t> b(nb2.lists().begin(i), nb2.lists().end(i));
     EXPECT_EQ(a, b);
+    EXPECT_TRUE(std::is_sorted(a.begin(), a.end()));
+    EXPECT_EQ(std::adjacent_find(a.begin(), a.end()), a.end());  // no body twice
   }
 }
 
@@ -229,6 +233,72 @@ TEST(ObbNeighbors, PartnerLeftOutOfTheFirstPredictionGivesTheSameCollisions) {
   const double e_fast = fast.model().kinetic_energy(fast.state());
   const double e_slow = slow.model().kinetic_energy(slow.state());
   EXPECT_NEAR(e_fast, e_slow, 1e-12 * e_slow);
+}
+
+// The axis memo (contact/axis_memo.hpp: each pair's search starts where its last one ended, and
+// one more pre-filter axis) against its slow twin, every search from its cold start: the same
+// collisions, fewer axis steps and more candidates ruled out before a solve, the same energy.
+TEST(ObbNeighbors, AxisMemoGivesTheSameCollisionsAsColdStarts) {
+  RigidSystemSpec spec;
+  spec.seed = 37;
+  spec.phi = 0.45;
+  Box box;
+  const State st = ellipsoid_start(spec, box);
+  auto cold_model = ellipsoid_model(spec);
+  cold_model.memo.on = false;
+  EllipsoidNnlSim cold(box, st, cold_model, ObbNeighbors<Ellipsoid>(cold_model.shape, 0.15));
+  auto fast = make_ellipsoid_nnl_simulation(spec, 0.15);
+  expect_same_collisions(cold, fast, hb::testing::scaled_count(1000, 0.05), "cold-started searches");
+  const SolverStats &f = fast.model().stats, &c = cold.model().stats;
+  std::printf("[ NNL ] axis steps %llu with the memo, %llu without; pre-filtered %llu and %llu\n",
+              (unsigned long long)f.axis_steps, (unsigned long long)c.axis_steps,
+              (unsigned long long)f.prefiltered, (unsigned long long)c.prefiltered);
+  EXPECT_LT(f.axis_steps, c.axis_steps);
+  EXPECT_GT(f.prefiltered, c.prefiltered);
+  EXPECT_EQ(f.fallbacks, 0u);
+  const double e_fast = fast.model().kinetic_energy(fast.state());
+  const double e_cold = cold.model().kinetic_energy(cold.state());
+  EXPECT_NEAR(e_fast, e_cold, 1e-12 * e_cold);
+}
+
+// A run continued from its snapshot (the loop, the neighbour boxes and the axis memo, as a
+// checkpoint holds them) repeats the uninterrupted run bit for bit; continued with the memo left
+// out, it does not (the memo steers the searches' last bits, so the checkpoint must hold it).
+TEST(ObbNeighbors, SnapshotWithTheAxisMemoContinuesBitForBit) {
+  RigidSystemSpec spec;
+  spec.seed = 41;
+  spec.phi = 0.45;
+  auto run = make_ellipsoid_nnl_simulation(spec, 0.15);
+  while (run.collisions() < std::uint64_t(hb::testing::scaled_count(2000, 0.1))) run.step(kInf);
+  const LoopSnapshot snap = run.snapshot();
+  ASSERT_FALSE(snap.memo.empty());
+  auto restored = [&](const LoopSnapshot& sn) {
+    ObbNeighbors<Ellipsoid> nb(run.model().shape, 0.15);
+    nb.restore(run.box(), run.state(), run.neighbors().snapshot());
+    auto model = ellipsoid_model(spec);
+    return EllipsoidNnlSim(run.box(), run.state(), model, std::move(nb), sn);
+  };
+  EllipsoidNnlSim same = restored(snap);
+  LoopSnapshot without = snap;
+  without.memo.clear();
+  EllipsoidNnlSim forgetful = restored(without);
+  EllipsoidNnlSim reference = run;
+  const int events = int(hb::testing::scaled_count(3000, 0.1));
+  bool forgetful_differs = false;
+  for (int k = 0; k < events; ++k) {
+    const StepInfo a = reference.step(kInf), b = same.step(kInf);
+    forgetful.step(kInf);
+    ASSERT_EQ(a.type, b.type) << k;
+    ASSERT_EQ(reference.now(), same.now()) << k;
+    forgetful_differs = forgetful_differs || reference.now() != forgetful.now();
+  }
+  reference.synchronize();
+  same.synchronize();
+  for (std::size_t i = 0; i < reference.state().size(); ++i) {
+    ASSERT_EQ(reference.state().r[i], same.state().r[i]) << i;
+    ASSERT_EQ(reference.state().q[i].coeffs(), same.state().q[i].coeffs()) << i;
+  }
+  EXPECT_TRUE(forgetful_differs);
 }
 
 // Mixtures (ObbNeighbors<AnyShape>): spheres, polydisperse ellipsoids and superquadrics grown to

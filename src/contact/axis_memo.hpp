@@ -1,0 +1,89 @@
+// The last separating axis of each pair, kept between solves: where the pair's next axis search
+// starts (ContactInput::axis_start, contact_time.hpp), one more fixed axis for the pre-filter of
+// predict_contacts (clear_along_axis, axis_gap.hpp), and where the distance solve starts when the
+// pair collides (touching_guess; the axis is then the contact normal the solver predicted).
+// Any unit vector is a valid start and any fixed axis gives a valid bound, so the memo changes
+// how many steps a search takes, never whether an answer is right. It does change the last bits
+// of a contact time (the path of the search), so a checkpoint saves it (AxisMemo::rows) for
+// `--resume` to continue bit for bit.
+//
+// Layout: per body i, kSlots slots direct-mapped by the partner index (j mod kSlots), each the
+// unit axis from i to j in the lab frame and j; a slot whose j differs is a miss. Measured
+// (callgrind, ellipsoids X0 = 2, phi = 0.5, N = 256; docs/benchmarks/README.md):
+// 16 / 32 / 64 slots -6.5 / -9.3 / -10.0 % instructions; 32 slots of floats -7.3 % (the
+// collision's distance solve then needs one more Newton step), of 16-bit octahedral pairs
+// -4.8 %. 32 slots of doubles: 1 kB a body.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <stdexcept>
+#include <vector>
+
+#include "math/types.hpp"
+
+namespace hb {
+
+class AxisMemo {
+ public:
+  static constexpr std::uint32_t kSlots = 32;
+  static constexpr std::uint32_t kNone = 0xffffffffu;
+  // One slot as the checkpoint stores it: x, y, z, j (j = kNone: empty), exact as doubles.
+  using Row = std::array<double, 4>;
+
+  // false: no memo (every search starts cold; the slow twin of the tests).
+  bool on = true;
+
+  // The axis from i to j of the pair's last solve in n (true), or false (n unchanged).
+  bool find(std::uint32_t i, std::uint32_t j, Vec3& n) const {
+    if (!on) return false;
+    const std::size_t k = index(i, j);
+    if (k >= slots_.size() || slots_[k].j != j) return false;
+    n = slots_[k].n;
+    return true;
+  }
+  // The pair's axis from i to j: i's slot for j, else j's slot for i negated.
+  bool find_either(std::uint32_t i, std::uint32_t j, Vec3& n) const {
+    if (find(i, j, n)) return true;
+    if (!find(j, i, n)) return false;
+    n = -n;
+    return true;
+  }
+  // The contact normal of a collision of i and j (from i to j), for both sides.
+  void store_both(std::size_t n_bodies, std::uint32_t i, std::uint32_t j, const Vec3& n) {
+    store(n_bodies, i, j, n);
+    store(n_bodies, j, i, Vec3(-n));
+  }
+  // Remembers axis n (from i to j, unit length) for the pair; n = 0 is not kept. n_bodies sizes
+  // the memo on first use.
+  void store(std::size_t n_bodies, std::uint32_t i, std::uint32_t j, const Vec3& n) {
+    if (!on || !(n.squaredNorm() > 0.0)) return;
+    if (slots_.size() < n_bodies * kSlots) slots_.resize(n_bodies * kSlots);
+    slots_[index(i, j)] = Slot{n, j};
+  }
+
+  // The whole memo for a checkpoint (empty if nothing was stored), and back.
+  std::vector<Row> rows() const {
+    std::vector<Row> r(slots_.size());
+    for (std::size_t k = 0; k < slots_.size(); ++k)
+      r[k] = {slots_[k].n.x(), slots_[k].n.y(), slots_[k].n.z(), double(slots_[k].j)};
+    return r;
+  }
+  void restore(const std::vector<Row>& r) {
+    if (r.size() % kSlots != 0) throw std::invalid_argument("axis memo: not whole bodies of slots");
+    slots_.resize(r.size());
+    for (std::size_t k = 0; k < r.size(); ++k)
+      slots_[k] = Slot{Vec3(r[k][0], r[k][1], r[k][2]), std::uint32_t(r[k][3])};
+  }
+
+ private:
+  struct Slot {
+    Vec3 n = Vec3::Zero();
+    std::uint32_t j = kNone;
+  };
+  static std::size_t index(std::uint32_t i, std::uint32_t j) {
+    return std::size_t(i) * kSlots + (j % kSlots);
+  }
+  std::vector<Slot> slots_;
+};
+
+}  // namespace hb
