@@ -196,8 +196,7 @@ void add_checkpoint_sources(gsd::FrameSource& f, const State& s, LoopSnapshot lo
   for (auto x : loop->counts) l.push_back(double(x));
   l.push_back(double(loop->rescheduled));
   f.log["hardbody/loop"] = record(l);
-  // The pair model's solver memo (rigid bodies: AxisMemo rows x, y, z, j), when it keeps one.
-  if (!loop->memo.empty())
+  if (!loop->memo.empty())  // a snapshot with the memo in it (make_checkpoint streams it instead)
     f.log["hardbody/solver_memo"] = gsd::row_source<double>(
         loop->memo.size(), 4, [loop](std::uint64_t k, double* o) {
           std::copy(loop->memo[k].begin(), loop->memo[k].end(), o);
@@ -221,6 +220,13 @@ void add_checkpoint_sources(gsd::FrameSource& f, const State& s, LoopSnapshot lo
   for (std::size_t a = 0; a < d.corr_species.size(); ++a)
     f.log[fmt::format("hardbody/obs_correlations_species{}", a)] = record(d.corr_species[a]);
   f.log["hardbody/config"] = record(config_signature(c).values);
+}
+
+gsd::ChunkSource memo_rows(const AxisMemo& m) {
+  return gsd::row_source<double>(m.size(), 4, [&m](std::uint64_t k, double* o) {
+    const AxisMemo::Row r = m.row(k);
+    std::copy(r.begin(), r.end(), o);
+  });
 }
 
 gsd::ChunkSource encode(std::vector<std::array<int, 3>> c) {

@@ -14,6 +14,7 @@
 #include "io/config.hpp"
 #include "io/gsd_hoomd.hpp"
 #include "io/run.hpp"
+#include "contact/axis_memo.hpp"
 #include "neighbors/obb_neighbors.hpp"
 #include "core/box.hpp"
 #include "system/simulation.hpp"
@@ -72,6 +73,9 @@ void add_checkpoint_sources(gsd::FrameSource& f, const State& s, LoopSnapshot lo
 gsd::ChunkSource encode(std::vector<std::array<int, 3>> c);
 gsd::ChunkSource encode(std::vector<Vec3> c);
 gsd::ChunkSource encode(ObbSnapshot c);
+// A view of a rigid model's axis memo (contact/axis_memo.hpp) as rows x, y, z, j of
+// hardbody/solver_memo, streamed: `m` must outlive the frame.
+gsd::ChunkSource memo_rows(const AxisMemo& m);
 
 // Reading back (throw InputError naming the file and the problem).
 struct Reader {
@@ -101,8 +105,12 @@ template <class Sim>
 gsd::FrameSource make_checkpoint(const Sim& sim, const SpeciesTable& species, const Config& c,
                                  const DriverState& d) {
   gsd::FrameSource f = make_frame(sim, species, true, nullptr);
-  ckpt::add_checkpoint_sources(f, sim.state(), sim.snapshot(), d, c);
+  ckpt::add_checkpoint_sources(f, sim.state(), sim.snapshot(/*with_memo=*/false), d, c);
   f.log["particles/hardbody/neighbors"] = ckpt::encode(sim.neighbors().snapshot());
+  // The model's memo between solves (rigid models), read back by read_core into the loop's
+  // snapshot: a view, not a copy (1 kB a body).
+  if constexpr (requires { sim.model().memo.size(); })
+    if (sim.model().memo.size() > 0) f.log["hardbody/solver_memo"] = ckpt::memo_rows(sim.model().memo);
   return f;
 }
 

@@ -125,7 +125,8 @@ class Simulation {
     for (const Event& e : snap.slot) queue_.set(e);
     restore_model_memo(model_, snap.memo);
   }
-  LoopSnapshot snapshot() const {
+  // with_memo = false leaves the model's memo out (a checkpoint streams it from the model).
+  LoopSnapshot snapshot(bool with_memo = true) const {
     LoopSnapshot s;
     s.now = now_;
     s.slot.resize(state_.size());
@@ -134,7 +135,7 @@ class Simulation {
     s.counts = counts_;
     s.stale = stale_;
     s.rescheduled = rescheduled_;
-    s.memo = model_memo(model_);
+    if (with_memo) s.memo = model_memo(model_);
     return s;
   }
 
@@ -310,9 +311,10 @@ class Simulation {
     };
   }
   // Hints for a body about to be predicted: its neighbour policy's records (ObbNeighbors: box
-  // and list), if the policy offers them.
+  // and list), if the policy offers them, and its slots of the model's memo, if it keeps one.
   void prefetch_neighbors(std::uint32_t i) const {
     if constexpr (requires { nb_.prefetch(i); }) nb_.prefetch(i);
+    if constexpr (requires { model_.memo.prefetch(i); }) model_.memo.prefetch(i);  // AxisMemo
   }
   // Is the pair (i, j), both streamed to now, in contact now? Its contact time from the current
   // state is within the tolerance (the search looks no further than twice the tolerance). Models
