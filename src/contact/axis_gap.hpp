@@ -394,8 +394,9 @@ Vec3 separating_axis_at(const SA& sa, const Quat& rot_a, const SB& sb, const Qua
 // l |w(t) x u| (the rate bound of AxisGap above, l the rotation lever). For a spherical top w
 // is constant; for any other top w(t) turns, and l |w(t)| <= l wmax bounds the rate instead
 // (wmax the top's largest angular speed, FreeRotation::max_angular_speed; pass wmax < 0 for a
-// spherical top). With these turn rates T_A, T_B and u = c / |c|,
-//     g_u(now) >= |c| - h_A(R_A^T u) - h_B(-R_B(t_B)^T u) - T_B age,
+// spherical top). With these turn rates T_A, T_B and a fixed unit direction u (clear_along_axis;
+// clear_along_centres takes u = c / |c|, so that u.c = |c|),
+//     g_u(now) >= u.c - h_A(R_A^T u) - h_B(-R_B(t_B)^T u) - T_B age,
 // and g_u falls at most at K_u = |u.dv| + T_A + T_B, so g_u(now) > K_u span keeps g_u, hence
 // the distance, positive over the window: true means no contact there (the answer the
 // contact-time solver would give; false: not decided). The margin 1e-10 (L_A + L_B) covers

@@ -196,11 +196,6 @@ void add_checkpoint_sources(gsd::FrameSource& f, const State& s, LoopSnapshot lo
   for (auto x : loop->counts) l.push_back(double(x));
   l.push_back(double(loop->rescheduled));
   f.log["hardbody/loop"] = record(l);
-  if (!loop->memo.empty())  // a snapshot with the memo in it (make_checkpoint streams it instead)
-    f.log["hardbody/solver_memo"] = gsd::row_source<double>(
-        loop->memo.size(), 4, [loop](std::uint64_t k, double* o) {
-          std::copy(loop->memo[k].begin(), loop->memo[k].end(), o);
-        });
   std::vector<double> dr{double(d.phase), d.e0, d.coll0, d.stale0, double(d.log_rows),
                          double(d.frames), d.next_snapshot, d.block_start, d.cpu_prev, d.wall_prev,
                          d.next_corr, d.next_gr, d.rescheduled0};

@@ -67,7 +67,8 @@ ConfigSignature config_signature(const Config& c);
 gsd::FrameSource frame_source(const State& s, const Box& box, double now, std::uint64_t step,
                               const SpeciesTable& species);
 // Adds what a resume needs: the state at the bodies' own time stamps (views of `s`), the event
-// calendar, the driver's accumulators and the config signature.
+// calendar, the driver's accumulators and the config signature. Not the model's memo
+// (loop.memo is not read): make_checkpoint streams it from the model (memo_rows).
 void add_checkpoint_sources(gsd::FrameSource& f, const State& s, LoopSnapshot loop,
                             const DriverState& d, const Config& c);
 gsd::ChunkSource encode(std::vector<std::array<int, 3>> c);

@@ -173,9 +173,6 @@ class ObbNeighbors {
     lists_.prefetch(i);
   }
 
-  // Candidates in index order (AdjacencyLists keeps each list sorted): the loop need not sort
-  // them for a model with a memo (system/simulation.hpp in_index_order).
-  static constexpr bool kIndexOrder = true;
   template <class Fn>
   void for_each_candidate(std::uint32_t i, const Box&, Fn&& fn) const {
     static const Vec3 zero = Vec3::Zero();

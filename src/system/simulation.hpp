@@ -333,7 +333,7 @@ class Simulation {
   }
   // Predict body i against the candidates in cand_ and keep the earliest in `best`.
   void consider(std::uint32_t i, Event& best, double horizon = kInf) {
-    if constexpr (keeps_memo() && !requires { Neighbors::kIndexOrder; }) in_index_order();
+    if constexpr (keeps_memo()) in_index_order();
     const std::size_t n = cand_.size();
     if (times_.size() < n) times_.resize(2 * n), limits_.resize(2 * n);
     const double* limits = nullptr;
