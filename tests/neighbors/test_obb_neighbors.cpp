@@ -176,6 +176,13 @@ void expect_same_collisions(SimA& a, SimB& b, std::size_t n, const char* what) {
   EXPECT_EQ(same, ha.size());
 }
 
+// Two twin runs end with the same kinetic energy (to 1e-12 relative).
+template <class SimA, class SimB>
+void expect_same_energy(const SimA& a, const SimB& b) {
+  const double ea = a.model().kinetic_energy(a.state()), eb = b.model().kinetic_energy(b.state());
+  EXPECT_NEAR(ea, eb, 1e-12 * eb);
+}
+
 TEST(ObbNeighbors, SameCollisionsAsCellListsOverlapFreeAndConservative) {
   RigidSystemSpec spec;
   spec.seed = 11;
@@ -230,9 +237,7 @@ TEST(ObbNeighbors, PartnerLeftOutOfTheFirstPredictionGivesTheSameCollisions) {
               (unsigned long long)fast.model().stats.predictions,
               (unsigned long long)slow.model().stats.predictions);
   EXPECT_LT(fast.model().stats.predictions, slow.model().stats.predictions);
-  const double e_fast = fast.model().kinetic_energy(fast.state());
-  const double e_slow = slow.model().kinetic_energy(slow.state());
-  EXPECT_NEAR(e_fast, e_slow, 1e-12 * e_slow);
+  expect_same_energy(fast, slow);
 }
 
 // The axis memo (contact/axis_memo.hpp: each pair's search starts where its last one ended, and
@@ -256,9 +261,7 @@ TEST(ObbNeighbors, AxisMemoGivesTheSameCollisionsAsColdStarts) {
   EXPECT_LT(f.axis_steps, c.axis_steps);
   EXPECT_GT(f.prefiltered, c.prefiltered);
   EXPECT_EQ(f.fallbacks, 0u);
-  const double e_fast = fast.model().kinetic_energy(fast.state());
-  const double e_cold = cold.model().kinetic_energy(cold.state());
-  EXPECT_NEAR(e_fast, e_cold, 1e-12 * e_cold);
+  expect_same_energy(fast, cold);
 }
 
 // A run continued from its snapshot (the loop, the neighbour boxes and the axis memo, as a
