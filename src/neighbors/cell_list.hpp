@@ -16,13 +16,15 @@
 namespace hb {
 
 // The width of the cells of a grid over the box L for n bodies: min_width, or wider so that there
-// are at most 64 cells per body (and 2^28 in all). A dilute box (phi = 1e-9) would otherwise ask
-// for ~1e11 empty cells; wider cells are as correct (a body still meets only the 27 cells around
-// it). A function of (L, min_width, n) alone: a checkpoint's cell coordinates fit the grid
-// rebuilt on restore. Throws std::invalid_argument when the box is narrower than min_width.
-inline double capped_cell_width(const Vec3& L, double min_width, std::size_t n_bodies) {
-  constexpr double kMaxCellsPerBody = 64.0, kMaxCells = double(1u << 28);
-  const double cap = std::min(kMaxCells, std::max(27.0, kMaxCellsPerBody * double(n_bodies)));
+// are at most max_per_body cells per body (64 by default; and 2^28 in all). A dilute box
+// (phi = 1e-9) would otherwise ask for ~1e11 empty cells; wider cells are as correct (a body
+// still meets only the 27 cells around it). A function of (L, min_width, n, max_per_body) alone:
+// a checkpoint's cell coordinates fit the grid rebuilt on restore. Throws std::invalid_argument
+// when the box is narrower than min_width.
+inline double capped_cell_width(const Vec3& L, double min_width, std::size_t n_bodies,
+                                double max_per_body = 64.0) {
+  constexpr double kMaxCells = double(1u << 28);
+  const double cap = std::min(kMaxCells, std::max(27.0, max_per_body * double(n_bodies)));
   double w = min_width;
   auto cells = [&] { return std::floor(L[0] / w) * std::floor(L[1] / w) * std::floor(L[2] / w); };
   for (int k = 0; k < 3; ++k)
@@ -44,10 +46,11 @@ class CellList {
     init(L, min_width, n_bodies, periodic);
   }
 
+  // max_per_body: the cap on cells per body of capped_cell_width.
   void init(const Vec3& L, double min_width, std::size_t n_bodies,
-            std::array<bool, 3> periodic = {true, true, true}) {
+            std::array<bool, 3> periodic = {true, true, true}, double max_per_body = 64.0) {
     periodic_ = periodic;
-    const double w = capped_cell_width(L, min_width, n_bodies);
+    const double w = capped_cell_width(L, min_width, n_bodies, max_per_body);
     auto count = [&](int k) { return std::floor(L[k] / w); };
     for (int k = 0; k < 3; ++k) {
       int nc = static_cast<int>(std::max(1.0, count(k)));
@@ -154,10 +157,17 @@ class CellList {
   // (zero along axes with a single cell, see needs_minimum_image()).
   template <class Fn>
   void for_each_neighbor(std::uint32_t i, const Vec3& L, Fn&& fn) const {
+    for_each_stencil_cell(i, L, [&](std::uint32_t cell, const Vec3& shift) { walk(cell, shift, fn); });
+  }
+  // Calls fn(c, shift) for every cell c of the 27 cells around body i's cell, with the image
+  // shift of its bodies as for_each_neighbor gives it (for a caller that keeps its own record
+  // of each cell's bodies: neighbors/cell_members.hpp).
+  template <class Fn>
+  void for_each_stencil_cell(std::uint32_t i, const Vec3& L, Fn&& fn) const {
     std::array<int, 3> lo{-1, -1, -1}, hi{1, 1, 1};
     for (int m = 0; m < 3; ++m)
       if (nc_[m] == 1) lo[m] = hi[m] = 0;
-    visit(coord_[i], lo, hi, L, fn);
+    visit_cells(coord_[i], lo, hi, L, fn);
   }
   // Calls fn(j, shift) for the bodies in the 9 cells that became adjacent to body i when it
   // entered its cell through face `face` (the far layer of the new 27-cell stencil).
@@ -188,6 +198,17 @@ class CellList {
   template <class Fn>
   void visit(const std::array<int, 3>& c, const std::array<int, 3>& lo,
              const std::array<int, 3>& hi, const Vec3& L, Fn& fn) const {
+    visit_cells(c, lo, hi, L, [&](std::uint32_t cell, const Vec3& shift) { walk(cell, shift, fn); });
+  }
+  // fn(j, shift) for each body j of the cell.
+  template <class Fn>
+  void walk(std::uint32_t cell, const Vec3& shift, Fn& fn) const {
+    for (std::uint32_t j = head_[cell]; j != kNone; j = next_[j]) fn(j, shift);
+  }
+  // The cells of visit, each once: fn(cell index, image shift).
+  template <class Fn>
+  void visit_cells(const std::array<int, 3>& c, const std::array<int, 3>& lo,
+                   const std::array<int, 3>& hi, const Vec3& L, Fn&& fn) const {
     int xs[3], ys[3], zs[3];
     double sx[3], sy[3], sz[3];
     const int nx = axis(c[0], lo[0], hi[0], 0, L[0], xs, sx);
@@ -196,10 +217,7 @@ class CellList {
     for (int a = 0; a < nz; ++a)
       for (int b = 0; b < ny; ++b) {
         const std::uint32_t row = static_cast<std::uint32_t>((zs[a] * nc_[1] + ys[b]) * nc_[0]);
-        for (int d = 0; d < nx; ++d) {
-          const Vec3 shift(sx[d], sy[b], sz[a]);
-          for (std::uint32_t j = head_[row + xs[d]]; j != kNone; j = next_[j]) fn(j, shift);
-        }
+        for (int d = 0; d < nx; ++d) fn(row + xs[d], Vec3(sx[d], sy[b], sz[a]));
       }
   }
   int axis(int c, int lo, int hi, int k, double L, int* out, double* shift) const {

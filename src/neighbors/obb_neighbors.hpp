@@ -53,6 +53,7 @@
 #include "events/event.hpp"
 #include "geometry/obb.hpp"
 #include "neighbors/cell_list.hpp"
+#include "neighbors/cell_members.hpp"
 #include "neighbors/shell_neighbors.hpp"
 #include "shapes/registry.hpp"
 #include "shapes/shape.hpp"
@@ -126,7 +127,7 @@ class ObbNeighbors {
       s.advance_to(i, now);
       s.image[i] += box.wrap(s.r[i]);
       set_box(i, s.r[i], s.q[i], half_extents_of(s, i));
-      cells_.insert(i, obb_[i].centre);
+      place(i);
     }
     build_all(box);
   }
@@ -149,7 +150,7 @@ class ObbNeighbors {
     setup(box, n);
     for (std::uint32_t i = 0; i < n; ++i) {
       set_box(i, sn.centre[i], sn.q[i], sn.half[i]);
-      cells_.insert(i, obb_[i].centre);
+      place(i);
     }
     build_all(box);
   }
@@ -235,9 +236,13 @@ class ObbNeighbors {
   bool handle(std::uint32_t i, const Event&, State& s, const Box& box, Fn&&) {
     ++rebuilds_;
     s.image[i] += box.wrap(s.r[i]);
-    set_box(i, s.r[i], s.q[i], obb_[i].half);
+    members_.remove(cells_.cell_of(i), i);
     cells_.remove(i);
-    cells_.insert(i, obb_[i].centre);
+    set_box(i, s.r[i], s.q[i], obb_[i].half);
+    place(i);
+    // i leaves its partners' lists: ask for them all before the first removal (each is a cache
+    // miss at large N, and each removal's search would wait for its own)
+    for (const std::uint32_t* p = lists_.begin(i); p != lists_.end(i); ++p) lists_.prefetch(*p);
     for (const std::uint32_t* p = lists_.begin(i); p != lists_.end(i); ++p) lists_.remove(*p, i);
     lists_.clear(i);
     link(i, box, [i](std::uint32_t j) { return j != i; });
@@ -277,7 +282,8 @@ class ObbNeighbors {
     const double rho = double(n) / box.volume();
     const double expect = rho * 4.18879 * reach * reach * reach;  // centres within 2 rc
     lists_.init(n, static_cast<std::uint32_t>(std::min<double>(expect + 16, double(n))));
-    cells_.init(box.L, reach, n, box.periodic);
+    cells_.init(box.L, reach, n, box.periodic, /*max_per_body=*/1.0);
+    members_.init(cells_.n_cells(), n);
     obb_.assign(n, Obb{});
     q_.assign(n, Quat::Identity());
   }
@@ -287,21 +293,36 @@ class ObbNeighbors {
     obb_[i].axes = q.toRotationMatrix();
     obb_[i].half = half;
   }
+  // Body i into the cell of its box centre.
+  void place(std::uint32_t i) {
+    cells_.insert(i, obb_[i].centre);
+    members_.insert(cells_.cell_of(i), i, obb_[i].centre);
+  }
   void build_all(const Box& box) {
     for (std::uint32_t i = 0; i < obb_.size(); ++i) link(i, box, [i](std::uint32_t j) { return j > i; });
   }
   // List i and j both ways for every j of the cell stencil with take(j) whose box overlaps i's.
   // Two passes: the cell walk gathers the candidates and asks for their boxes, then the overlap
-  // tests read them (in the same order, so the same lists). At large N the boxes of a cell's
-  // bodies lie all over memory; one pass waited for each box before walking on (measured at
-  // N = 256000: 63 % of Simulation::step on that load).
+  // tests read them. At large N the boxes of a cell's bodies lie all over memory; one pass waited
+  // for each box before walking on (measured at N = 256000: 63 % of Simulation::step on that
+  // load). The walk reads the cells' packed members (CellMembers): their single-precision
+  // centres rule out, before any box is loaded, the ~85 % of the stencil's bodies whose
+  // circumspheres are apart by more than the rounding (the exact test, overlap, decides the
+  // rest). With single-cell axes (minimum image) every member goes to the exact test. The lists
+  // are sorted, so the order of the candidates does not matter.
   template <class Take>
   void link(std::uint32_t i, const Box& box, Take take) {
     near_.clear();
-    cells_.for_each_neighbor(i, box.L, [&](std::uint32_t j, const Vec3& shift) {
-      if (!take(j)) return;
-      __builtin_prefetch(&obb_[j]);
-      near_.push_back({j, shift});
+    const Vec3 ci = obb_[i].centre;
+    const bool image = cells_.needs_minimum_image();
+    const double reach = 2.0 * rc_ + members_.rounding_bound(), reach2 = reach * reach;
+    cells_.for_each_stencil_cell(i, box.L, [&](std::uint32_t c, const Vec3& shift) {
+      const Vec3 from = ci - shift;  // j's centre minus this: the centre separation
+      for (const CellMembers::Member* m = members_.begin(c); m != members_.end(c); ++m) {
+        if (!take(m->id) || (!image && (m->centre() - from).squaredNorm() > reach2)) continue;
+        __builtin_prefetch(&obb_[m->id]);
+        near_.push_back({m->id, shift});
+      }
     });
     for (const auto& [j, shift] : near_)
       if (overlap(i, j, shift, box)) lists_.add(i, j), lists_.add(j, i);
@@ -323,6 +344,7 @@ class ObbNeighbors {
   double rc_ = 0.0;          // box circumradius (a mixture: the largest)
   double kbound_l_ = 0.0;    // bounding radius (speed bound of the body's points)
   CellList cells_;           // over box centres; changes only at rebuilds
+  CellMembers members_;      // its cells' bodies, packed with their centres (link's walk)
   std::vector<Obb> obb_;
   std::vector<Quat> q_;
   std::vector<std::pair<std::uint32_t, Vec3>> near_;  // link's candidates (scratch)
