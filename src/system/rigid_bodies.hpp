@@ -154,19 +154,22 @@ inline double max_spin(const State& s, std::uint32_t j) {
 
 // The second pre-filter of the rigid models (predict_contacts' `clear`): body i (shape A, state
 // a at `now`) and candidate j (shape B, centre separation c at `now`, orientation at its own
-// time) cannot touch before `horizon` by the gap along their line of centres
-// (clear_along_centres), or else along the pair's last separating axis in the memo
-// (clear_along_axis): any fixed axis gives a valid bound.
+// time) cannot touch before `horizon` by the gap along the pair's last separating axis in the
+// memo (clear_along_axis), or else along their line of centres (clear_along_centres): any fixed
+// axis gives a valid bound. The answer is the same in either order; the memo's axis comes first
+// because it separates more often (the pair's best axis a few events ago), so the second test
+// runs less often (measured: docs/benchmarks/README.md, "Session of 2026-11-29, sixth part").
 template <class SA, class SB>
-bool clear_along_centres_or_memo(const SA& A, const SB& B, const State& s, std::uint32_t i,
+bool clear_along_memo_or_centres(const SA& A, const SB& B, const State& s, std::uint32_t i,
                                  const BodyState& a, std::uint32_t j, const Vec3& c, double now,
                                  double horizon, const AxisMemo& memo) {
   const Vec3 dv = s.v[j] - a.v;
   const double wa = max_spin(a), wb = max_spin(s, j), age = now - s.t[j], span = horizon - now;
-  if (clear_along_centres(A, a.q, a.w, B, s.q[j], s.w[j], c, dv, age, span, wa, wb)) return true;
   Vec3 u;
-  return memo.find(i, j, u) &&
-         clear_along_axis(A, a.q, a.w, B, s.q[j], s.w[j], c, Vec3(u.normalized()), dv, age, span, wa, wb);
+  if (memo.find(i, j, u) &&
+      clear_along_axis(A, a.q, a.w, B, s.q[j], s.w[j], c, Vec3(u.normalized()), dv, age, span, wa, wb))
+    return true;
+  return clear_along_centres(A, a.q, a.w, B, s.q[j], s.w[j], c, dv, age, span, wa, wb);
 }
 
 // The prediction loop of the rigid pair models (RigidBodies, RigidMixture): body i (at `now`)
@@ -338,14 +341,14 @@ struct RigidBodies {
   }
   // The pre-filter of predict_contacts after the bounding spheres (no growth): body i (state a
   // at `now`) and candidate j (centre separation c at `now`, orientation at its own time) cannot
-  // touch before `horizon` by the gap along their line of centres (clear_along_centres,
+  // touch before `horizon` by the gap along the pair's last separating axis (the memo), then, if
+  // that does not decide, along their line of centres (clear_along_memo_or_centres,
   // contact/axis_gap.hpp; for tops that are not spherical with their largest angular speeds,
-  // from the free rotation the solver uses), then, if that does not decide, by the gap along
-  // the pair's last separating axis (the memo); false when off (centre_line_test, the slow twin)
+  // from the free rotation the solver uses); false when off (centre_line_test, the slow twin)
   // or not decided.
   bool centre_line_clear(const State& s, std::uint32_t i, const BodyState& a, std::uint32_t j,
                          const Vec3& c, double now, double horizon) const {
-    return centre_line_test && clear_along_centres_or_memo(shape, shape, s, i, a, j, c, now, horizon, memo);
+    return centre_line_test && clear_along_memo_or_centres(shape, shape, s, i, a, j, c, now, horizon, memo);
   }
   // The radius of contact_time's bounding-sphere test for two bodies of this shape at scale 1
   // (no growth): L_A + L_B plus its margin.
