@@ -306,6 +306,7 @@ class Simulation {
       // windowed models read each candidate's calendar entry for its horizon (consider), after
       // the owner's neighbour event is computed: ask for it now
       if constexpr (windowed() && requires { queue_.prefetch(j); }) queue_.prefetch(j);
+      state_.prefetch(j);
       cand_.push_back(j);
       shift_.push_back(shift);
     };
