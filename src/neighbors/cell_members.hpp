@@ -62,8 +62,11 @@ class CellMembers {
     --size_[cell];
   }
   // A bound on |m.centre() - c| for every member inserted at centre c: sqrt(3) 2^-24 times the
-  // largest coordinate inserted, doubled.
-  double rounding_bound() const { return 2.0 * 1.7320508075688772 * std::ldexp(max_abs_, -24); }
+  // largest coordinate inserted, doubled, plus 1e-44 (a coordinate below float's normal range
+  // is rounded to within 2^-150 absolute).
+  double rounding_bound() const {
+    return 2.0 * 1.7320508075688772 * std::ldexp(max_abs_, -24) + 1e-44;
+  }
 
  private:
   void grow() {

@@ -315,7 +315,10 @@ class ObbNeighbors {
     near_.clear();
     const Vec3 ci = obb_[i].centre;
     const bool image = cells_.needs_minimum_image();
-    const double reach = 2.0 * rc_ + members_.rounding_bound(), reach2 = reach * reach;
+    // the cut-off widened by the centres' rounding, and by the double-precision rounding of the
+    // separation and its square (relative 1e-15 of the coordinates, the shift and the reach)
+    const double reach = 2.0 * rc_ + members_.rounding_bound() + 1e-14 * (box.L.maxCoeff() + rc_);
+    const double reach2 = reach * reach;
     cells_.for_each_stencil_cell(i, box.L, [&](std::uint32_t c, const Vec3& shift) {
       const Vec3 from = ci - shift;  // j's centre minus this: the centre separation
       for (const CellMembers::Member* m = members_.begin(c); m != members_.end(c); ++m) {
