@@ -55,9 +55,12 @@
 //     sample that would have bracketed it is saved. The same Newton runs first from the end of
 //     the axis leaps of step a (curved pairs: the gap g < eps_d of the last axis and its rate
 //     g' < 0 give the start, the support points the contact point), which saves the first
-//     distance solve too (Solver::solve_ahead_of_axis). The distance solve that accepts a
-//     Newton root starts from the root's contact point (one NR iteration). A hit then costs
-//     one distance solve instead of three. Otherwise the step is taken as above.
+//     distance solve too (Solver::solve_ahead_of_axis). A Newton root is accepted without a
+//     distance solve when its own residuals certify it (ContactOptions::certify_newton,
+//     Solver::certified_contact: the point on both surfaces, opposite normals, so by convexity
+//     the common tangent plane separates the bodies, and approaching); otherwise by a distance
+//     solve from the root's contact point (one NR iteration). A hit from the axis leaps then
+//     costs no distance solve at all. Otherwise the step is taken as above.
 //  Separating-axis advancement (beyond the paper; shapes with a support function; with growth
 //  the gap and its bounds carry the scale law, axis_gap.hpp).
 //  The gap g_n(t) along a fixed unit vector n (contact/axis_gap.hpp) is a lower bound of the
@@ -195,6 +198,11 @@ struct ContactOptions {
   // ahead and certify it by a new axis (Solver::leaving_flat) instead of sampling the distance
   // (false: the samples, the slow twin).
   bool leave_jump = true;
+  // A contact-system Newton root accepted by its own residuals and convexity
+  // (Solver::certified_contact) instead of a distance solve at the root (false: the distance
+  // solve, the slow twin). Only acceptances are shortcut; what it cannot certify is checked by
+  // the distance solve as before.
+  bool certify_newton = true;
   DistanceOptions distance{};
 };
 
@@ -216,6 +224,7 @@ struct ContactResult {
   int axis_steps = 0;           // separating-axis gap values (the first after a search is its own)
   int axis_bounds = 0;          // evaluations of the affine gap bound (flat-faced pairs)
   int ahead = 0;                // contacts found by Newton ahead of a sample (step 4')
+  int certified = 0;            // Newton roots accepted without a distance solve (certify_newton)
   DistanceWarmStart warm;       // last distance solution (warm start for the next prediction)
 };
 
@@ -695,8 +704,11 @@ struct Solver {
   // The Newton result y (time in [t_lo, t_hi]) checked by a distance solve there: a contact if
   // the distance is zero to accept_tol and, with `entering`, the bodies approach (d' < 0).
   // Reports the hit and returns true; false otherwise (or if the solve failed: `failed`).
+  // With ContactOptions::certify_newton the root is first certified without the distance solve
+  // (certified_contact); what that cannot certify goes to the distance solve as before.
   bool accept_newton(const Vec5c& y, double t_lo, double t_hi, bool entering) {
     const double tc = std::clamp(y[4], t_lo, t_hi);
+    if (o.certify_newton && certified_contact(y.head<3>(), tc, entering)) return true;
     // The distance solve starts from the Newton point: both closest points there (touching),
     // the multiplier alpha of the contact system (the distance solver's own, beta = 0).
     if (!grow) {
@@ -713,6 +725,39 @@ struct Solver {
     Mat3 h_;
     A.eval(y.head<3>(), tc, f_, g_, h_, ft_, gt_);
     report_hit(tc, y.head<3>(), g_.normalized());
+    return true;
+  }
+
+  // The Newton root certified by convexity, without a distance solve: the point x lies on both
+  // surfaces at tc (first-order distances |f| / |grad f| within accept_tol L) and their outward
+  // normals n_A, n_B are opposite (|n_A + n_B| <= accept_tol). Then the common tangent plane
+  // at x has A on one side and B on the other (both convex), so the bodies touch: the distance
+  // is zero to the tolerance the distance solve would check, and no overlap is possible beyond
+  // the normals' misfit over the bodies' size (accept_tol L). With `entering`, the rate of the
+  // gap at the touching point, n_A . (u_B(x) - u_A(x)) (u the surface point's velocity, as
+  // eval computes d' at the closest points), must be below -accept_tol K: a grazing pair whose
+  // rate is within rounding of zero is left to the distance solve, so that the sign is decided
+  // as before. Reports the hit (the same time, point and normal as the distance-solve path)
+  // and returns true; false: not certified (nothing reported, nothing changed).
+  bool certified_contact(const Vec3& x, double tc, bool entering) {
+    double fa, fb, fta, ftb;
+    Vec3 ga, gb, gta, gtb;
+    Mat3 ha, hb;
+    A.eval(x, tc, fa, ga, ha, fta, gta);
+    B.eval(x, tc, fb, gb, hb, ftb, gtb);
+    const double na = ga.norm(), nb = gb.norm();
+    const double tol = o.accept_tol * L;
+    if (!(na > 0.0 && nb > 0.0 && std::abs(fa) <= tol * na && std::abs(fb) <= tol * nb)) return false;
+    const Vec3 n = ga / na;
+    if (!((n + gb / nb).norm() <= o.accept_tol)) return false;
+    if (entering) {
+      Vec3 wa, wb;
+      const Pose pa = A.pose_at(tc, wa), pb = B.pose_at(tc, wb);
+      const double rate = n.dot(B.point_velocity(x, pb, tc, wb) - A.point_velocity(x, pa, tc, wa));
+      if (!(rate < -o.accept_tol * K)) return false;
+    }
+    report_hit(tc, x, ga.normalized());
+    ++out.certified;
     return true;
   }
 

@@ -176,6 +176,17 @@ void expect_same_collisions(SimA& a, SimB& b, std::size_t n, const char* what) {
   EXPECT_EQ(same, ha.size());
 }
 
+// The NNL run of `spec` (shell 0.15) with its model changed by tweak(model): the slow twin of
+// make_ellipsoid_nnl_simulation's run, started from the same state.
+template <class Tweak>
+EllipsoidNnlSim tweaked_nnl_simulation(const RigidSystemSpec& spec, Tweak&& tweak) {
+  Box box;
+  const State st = ellipsoid_start(spec, box);
+  auto model = ellipsoid_model(spec);
+  tweak(model);
+  return EllipsoidNnlSim(box, st, model, ObbNeighbors<Ellipsoid>(model.shape, 0.15));
+}
+
 // Two twin runs end with the same kinetic energy (to 1e-12 relative).
 template <class SimA, class SimB>
 void expect_same_energy(const SimA& a, const SimB& b) {
@@ -247,11 +258,7 @@ TEST(ObbNeighbors, AxisMemoGivesTheSameCollisionsAsColdStarts) {
   RigidSystemSpec spec;
   spec.seed = 37;
   spec.phi = 0.45;
-  Box box;
-  const State st = ellipsoid_start(spec, box);
-  auto cold_model = ellipsoid_model(spec);
-  cold_model.memo.on = false;
-  EllipsoidNnlSim cold(box, st, cold_model, ObbNeighbors<Ellipsoid>(cold_model.shape, 0.15));
+  auto cold = tweaked_nnl_simulation(spec, [](auto& m) { m.memo.on = false; });
   auto fast = make_ellipsoid_nnl_simulation(spec, 0.15);
   expect_same_collisions(cold, fast, hb::testing::scaled_count(1000, 0.05), "cold-started searches");
   const SolverStats &f = fast.model().stats, &c = cold.model().stats;
@@ -262,6 +269,25 @@ TEST(ObbNeighbors, AxisMemoGivesTheSameCollisionsAsColdStarts) {
   EXPECT_GT(f.prefiltered, c.prefiltered);
   EXPECT_EQ(f.fallbacks, 0u);
   expect_same_energy(fast, cold);
+}
+
+// Contact-time Newton roots certified without a distance solve (ContactOptions::certify_newton)
+// against the slow twin, a distance solve at every root: the same collisions, the same energy,
+// and the hits' distance solves gone.
+TEST(ObbNeighbors, CertifiedNewtonRootsGiveTheSameCollisions) {
+  RigidSystemSpec spec;
+  spec.seed = 43;
+  spec.phi = 0.45;
+  auto solve = tweaked_nnl_simulation(spec, [](auto& m) { m.options.certify_newton = false; });
+  auto fast = make_ellipsoid_nnl_simulation(spec, 0.15);
+  expect_same_collisions(solve, fast, hb::testing::scaled_count(1000, 0.05), "distance solves at the roots");
+  const SolverStats &f = fast.model().stats, &c = solve.model().stats;
+  std::printf("[ NNL ] distance solves in hits: %llu certified, %llu solved (%llu hits)\n",
+              (unsigned long long)f.hit_distance_evals, (unsigned long long)c.hit_distance_evals,
+              (unsigned long long)f.hits);
+  EXPECT_EQ(f.hits, c.hits);
+  EXPECT_LT(2 * f.hit_distance_evals, c.hit_distance_evals);
+  expect_same_energy(fast, solve);
 }
 
 // A run continued from its snapshot (the loop, the neighbour boxes and the axis memo, as a
