@@ -151,7 +151,7 @@ struct Tally {
   double cpu = 0, wall = 0, collisions = 0, neighbour_events = 0, stale = 0;
   double predictions = 0, distance_evals = 0, distance_nr = 0, axis_steps = 0, axis_bounds = 0, hits = 0,
          hit_distance_evals = 0, grazing = 0, contact_fallbacks = 0, distance_fallbacks = 0,
-         collision_distance_fallbacks = 0, prefiltered = 0, centre_line_clears = 0;
+         collision_distance_fallbacks = 0, prefiltered = 0, centre_line_clears = 0, collision_touches = 0;
   Tally operator-(const Tally& o) const {
     Tally d;
     d.cpu = cpu - o.cpu, d.wall = wall - o.wall, d.collisions = collisions - o.collisions;
@@ -165,6 +165,7 @@ struct Tally {
     d.collision_distance_fallbacks = collision_distance_fallbacks - o.collision_distance_fallbacks;
     d.prefiltered = prefiltered - o.prefiltered;
     d.centre_line_clears = centre_line_clears - o.centre_line_clears;
+    d.collision_touches = collision_touches - o.collision_touches;
     return d;
   }
   Tally& operator+=(const Tally& o) {
@@ -175,6 +176,7 @@ struct Tally {
     contact_fallbacks += o.contact_fallbacks, distance_fallbacks += o.distance_fallbacks;
     collision_distance_fallbacks += o.collision_distance_fallbacks;
     prefiltered += o.prefiltered, centre_line_clears += o.centre_line_clears;
+    collision_touches += o.collision_touches;
     return *this;
   }
   double fallbacks() const { return contact_fallbacks + distance_fallbacks + collision_distance_fallbacks; }
@@ -203,6 +205,7 @@ Tally tally(const Sim& sim) {
     t.distance_fallbacks = double(s.distance_fallbacks);
     t.collision_distance_fallbacks = double(s.collision_distance_fallbacks);
     t.prefiltered = double(s.prefiltered), t.centre_line_clears = double(s.centre_line_clears);
+    t.collision_touches = double(s.collision_touches);
   }
   return t;
 }
@@ -246,6 +249,7 @@ inline void put_costs(Json& j, const Tally& d) {
   // (system/rigid_bodies.hpp predict_contacts), and by the line of centres alone
   j["prefiltered_per_collision"] = d.prefiltered / nc;
   j["centre_line_clears_per_collision"] = d.centre_line_clears / nc;
+  j["collision_touches_per_collision"] = d.collision_touches / nc;
   j["distance_evals_per_prediction"] = d.distance_evals / np;
   j["distance_evals_per_collision"] = d.distance_evals / nc;
   j["distance_nr_iterations_per_eval"] = d.distance_nr / std::max(d.distance_evals, 1.0);

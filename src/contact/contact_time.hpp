@@ -203,6 +203,11 @@ struct ContactOptions {
   // solve, the slow twin). Only acceptances are shortcut; what it cannot certify is checked by
   // the distance solve as before.
   bool certify_newton = true;
+  // At a collision of the rigid models, the contact read off the pair's memo axis when that is
+  // the contact normal the prediction stored (touching_along, system/rigid_bodies.hpp: the
+  // support points coincide to accept_tol) instead of a distance solve (false: the distance
+  // solve from the axis' touching guess, the slow twin).
+  bool touch_from_memo = true;
   DistanceOptions distance{};
 };
 

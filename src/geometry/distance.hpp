@@ -180,7 +180,8 @@ struct DistanceResult {
   double alpha = 0.0, beta = 0.0;
   int nr_iterations = 0;        // total over all attempts
   int sd_iterations = 0;
-  int attempt = 0;              // stage that succeeded: 1 warm, 2 cold, 3-8 fallbacks (header)
+  int attempt = 0;              // stage that succeeded: 1 warm, 2 cold, 3-8 fallbacks (header);
+                                // 0 with status converged: no solve (touching_along)
   bool warm_used = false;
   DistanceWarmStart warm;       // feed back as the warm start of the next call for this pair
 };

@@ -43,6 +43,7 @@ struct SolverStats {
   std::uint64_t hit_distance_evals = 0;   // distance solves inside those
   std::uint64_t prefiltered = 0;  // predictions answered by predict_contacts' pre-filters, no solver
   std::uint64_t centre_line_clears = 0;  // those of them answered by the line of centres
+  std::uint64_t collision_touches = 0;   // collisions whose contact was read off the memo axis
 
   void add(const ContactResult& r) {
     ++predictions;
@@ -115,7 +116,37 @@ CollisionContact collision_contact(const BodyState& a, const BodyState& b, const
         "{{\"a\": {}, \"b\": {}}}", i, j, body(ja, a.r, a.q), body(jb, pb.r, b.q)));
   }
   if (c.d.status == DistanceStatus::fallback) ++stats.collision_distance_fallbacks;
+  if (c.d.attempt == 0) ++stats.collision_touches;  // touching_along: no solver stage
   return c;
+}
+
+// The contact of two bodies that touch, read off a lab axis n (from A to B) that is their
+// contact normal: the support point p_A of A along n and p_B of B along -n (lab frame). A lies in
+// the half-space n.x <= n.p_A and B in n.x >= n.p_B, so the distance is at least
+// g = n.(p_B - p_A); both points lie in the bodies, so it is at most |p_B - p_A|. When
+// |p_B - p_A| <= tol (a fraction of the bodies' size times their larger bounding radius) the
+// bodies touch to that tolerance at p_A ~ p_B with normal n, the same contact a distance solve
+// would find (to its own tolerance): `out` gets distance g, the two points and n, and true
+// is returned. Otherwise (n is not the contact normal, or a flat face's support point is not
+// the touching one): false, `out` untouched.
+template <SupportShape SA, SupportShape SB>
+bool touching_along(const SA& sa, const Quat& qa, const Pose& pa, const SB& sb, const Quat& qb,
+                    const Pose& pb, const Vec3& axis, double tol, DistanceResult& out) {
+  const double an = axis.norm();
+  if (!(an > 0.0)) return false;
+  const Vec3 n = axis / an;
+  const Vec3 p_a = pa.r + pa.R * sa.support_point(qa.conjugate() * n);
+  const Vec3 p_b = pb.r + pb.R * sb.support_point(-(qb.conjugate() * n));
+  const Vec3 sep = p_b - p_a;
+  if (!(sep.norm() <= tol * std::max(sa.bounding_radius(), sb.bounding_radius()))) return false;
+  out = DistanceResult{};
+  out.status = DistanceStatus::converged;
+  out.distance = n.dot(sep);
+  out.point_a = p_a;
+  out.point_b = p_b;
+  out.normal = n;
+  out.attempt = 0;  // no solver stage: read off the axis (counted in SolverStats::collision_touches)
+  return true;
 }
 
 // The distance solve at a collision of shapes sa, sb at poses pa, pb (orientations qa, qb):
@@ -125,12 +156,17 @@ CollisionContact collision_contact(const BodyState& a, const BodyState& b, const
 // 11 -> 3). Without, or if that start does not converge, the solver's own stages run as before.
 // `start` (lab frame, from A to B), if given: where the guess's axis search starts (the pair's
 // memo, contact/axis_memo.hpp) instead of the line of centres.
+// `touch` > 0 (with `start`): first try the contact read off the start axis itself
+// (touching_along), which is the pair's contact normal when the prediction that scheduled this
+// collision stored it in the memo; no distance solve then.
 template <Shape SA, Shape SB>
 DistanceResult collision_distance(const SA& sa, const Quat& qa, const Pose& pa, const SB& sb,
                                   const Quat& qb, const Pose& pb, const DistanceOptions& o,
-                                  bool guess, const Vec3* start = nullptr) {
+                                  bool guess, const Vec3* start = nullptr, double touch = 0.0) {
   if constexpr (SupportShape<SA> && SupportShape<SB> &&
                 !(std::is_same_v<SA, Sphere> && std::is_same_v<SB, Sphere>)) {
+    DistanceResult d;
+    if (start && touch > 0.0 && touching_along(sa, qa, pa, sb, qb, pb, *start, touch, d)) return d;
     if (guess) {
       const DistanceWarmStart w = touching_guess(sa, qa, sb, qb, Vec3(pb.r - pa.r), 12, start);
       return distance(sa, pa, sb, pb, o, w.valid ? &w : nullptr);
@@ -372,14 +408,15 @@ struct RigidBodies {
     const double sc = law.scale_at(now), sdot = law.rate_at(now);
     Vec3 start;
     const Vec3* from = memo.find_either(i, j, start) ? &start : nullptr;
+    const double touch = options.touch_from_memo ? options.accept_tol : 0.0;
     const auto [r_ab, d] = collision_contact(
         a, b, box, i, j, stats,
         [&](const Pose& pa, const Pose& pb) {
           const bool guess = options.separating_axis;
           if (sc == 1.0)
-            return collision_distance(shape, a.q, pa, shape, b.q, pb, options.distance, guess, from);
+            return collision_distance(shape, a.q, pa, shape, b.q, pb, options.distance, guess, from, touch);
           const auto shp = scaled_shape(shape, sc);
-          return collision_distance(shp, a.q, pa, shp, b.q, pb, options.distance, guess, from);
+          return collision_distance(shp, a.q, pa, shp, b.q, pb, options.distance, guess, from, touch);
         },
         [&] {
           const std::string js = hb::shape_json(AnyShape(resized(shape, sc)));

@@ -186,6 +186,7 @@ struct RigidMixture {
     const AnyShape sa = body_shape(s, i), sb = body_shape(s, j);
     Vec3 start;
     const Vec3* from = memo.find_either(i, j, start) ? &start : nullptr;
+    const double touch = options.touch_from_memo ? options.accept_tol : 0.0;
     const auto [r_ab, d] = collision_contact(
         a, b, box, i, j, stats,
         [&](const Pose& pa, const Pose& pb) {
@@ -193,9 +194,9 @@ struct RigidMixture {
               [&](const auto& A, const auto& B) {
                 const bool guess = options.separating_axis;
                 if (sc == 1.0)
-                  return collision_distance(A, a.q, pa, B, b.q, pb, options.distance, guess, from);
+                  return collision_distance(A, a.q, pa, B, b.q, pb, options.distance, guess, from, touch);
                 return collision_distance(resized(A, sc), a.q, pa, resized(B, sc), b.q, pb,
-                                          options.distance, guess, from);
+                                          options.distance, guess, from, touch);
               },
               sa, sb);
         },

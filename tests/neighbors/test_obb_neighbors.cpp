@@ -290,6 +290,37 @@ TEST(ObbNeighbors, CertifiedNewtonRootsGiveTheSameCollisions) {
   expect_same_energy(fast, solve);
 }
 
+// Collisions whose contact is read off the pair's memo axis (ContactOptions::touch_from_memo,
+// touching_along) against the slow twin, a distance solve at every collision: the contacts
+// agree to the solvers' tolerance, not bit for bit, so the runs would part after a while (the
+// fluid is chaotic); the first 1000 collisions are the same to 1e-9, most contacts are read off
+// the axis, and a longer run has no overlap and conserves the energy.
+TEST(ObbNeighbors, ContactsReadOffTheMemoAxisGiveTheSameCollisions) {
+  RigidSystemSpec spec;
+  spec.seed = 47;
+  spec.phi = 0.45;
+  auto solve = tweaked_nnl_simulation(spec, [](auto& m) { m.options.touch_from_memo = false; });
+  auto fast = make_ellipsoid_nnl_simulation(spec, 0.15);
+  expect_same_collisions(solve, fast, hb::testing::scaled_count(1000, 0.05), "distance solves at the collisions");
+  const std::uint64_t touches = fast.model().stats.collision_touches;
+  std::printf("[ NNL ] contacts read off the memo axis: %llu of %llu collisions (slow twin %llu)\n",
+              (unsigned long long)touches, (unsigned long long)fast.collisions(),
+              (unsigned long long)solve.model().stats.collision_touches);
+  EXPECT_EQ(solve.model().stats.collision_touches, 0u);
+  EXPECT_GT(touches, fast.collisions() * 9 / 10);
+  const double e0 = fast.model().kinetic_energy(fast.state());
+  const std::uint64_t target = hb::testing::scaled_count(20000, 0.01);
+  while (fast.collisions() < target) fast.step(kInf);
+  fast.synchronize();
+  const double e1 = fast.model().kinetic_energy(fast.state());
+  const OverlapReport ov = ellipsoid_overlaps(fast.state().r, fast.state().q, fast.box(), spec.semi_axes);
+  std::printf("[ NNL ] %llu collisions: overlaps %lu, min gap %.3e, relative energy drift %.2e\n",
+              (unsigned long long)fast.collisions(), (unsigned long)ov.overlaps, ov.min_distance,
+              std::abs(e1 - e0) / e0);
+  EXPECT_EQ(ov.overlaps, 0u);
+  EXPECT_LT(std::abs(e1 - e0) / e0, 1e-10);
+}
+
 // A run continued from its snapshot (the loop, the neighbour boxes and the axis memo, as a
 // checkpoint holds them) repeats the uninterrupted run bit for bit; continued with the memo left
 // out, it does not (the memo steers the searches' last bits, so the checkpoint must hold it).

@@ -117,5 +117,69 @@ TEST(CollisionDistance, TouchingGuessAgreesWithTheColdSolveForSuperquadrics) {
   EXPECT_LE(t.dist, 1e-10);
 }
 
+// The contact read off an axis (touching_along, the collision's shortcut when the pair's memo
+// holds its contact normal) against the cold solve: on touching pairs and pairs within rounding
+// of touching, along their exact normal, it must certify and give the same distance (to
+// 1e-11 L), normal and, for strictly convex bodies, closest points; for pairs apart by more than
+// its tolerance, or along an axis tilted off the normal, it must decline (the distance solve
+// then runs). Ellipsoids up to aspect 10, ellipsoid and sphere, superquadrics (exponents 4, 8).
+template <SupportShape SA, SupportShape SB>
+void check_touch(Rng& r, const SA& a, const SB& b, bool unique, int k, Tally& t, int& declined) {
+  const double L = std::max(a.bounding_radius(), b.bounding_radius());
+  const Pose pa{r.ball(1.0), r.rotation()};
+  const Vec3 n = r.unit();
+  const int kind = k % 4;  // 0, 1: touching to rounding; 2: apart; 3: tilted axis
+  const double gap = kind == 0 ? 0.0 : kind == 1 ? r.uni(-1.0, 1.0) * r.log_uni(1e-15, 1e-12) * L
+                                     : kind == 2 ? r.log_uni(1e-9, 1e-3) * L : 0.0;
+  const Pose pb = testing::place_at_distance(a, pa, b, r.rotation(), n, gap);
+  const Vec3 axis = kind == 3 ? Vec3(testing::small_rotation(r, r.log_uni(1e-6, 1e-2)) * n) : n;
+  DistanceResult d;
+  const bool took = touching_along(a, Quat(pa.R), pa, b, Quat(pb.R), pb, axis, 1e-10, d);
+  if (kind >= 2) {
+    EXPECT_FALSE(took) << "kind " << kind << " pair " << k;
+    declined += !took;
+    return;
+  }
+  ASSERT_TRUE(took) << "pair " << k << " gap " << gap;
+  const DistanceResult c =
+      collision_distance(a, Quat(pa.R), pa, b, Quat(pb.R), pb, DistanceOptions{}, false);
+  ASSERT_NE(c.status, DistanceStatus::failed);
+  ++t.n;
+  t.dist = std::max({t.dist, std::abs(d.distance - gap) / L, std::abs(d.distance - c.distance) / L});
+  t.normal = std::max(t.normal, (d.normal - c.normal).norm());
+  if (unique)
+    t.points = std::max({t.points, (d.point_a - c.point_a).norm() / L, (d.point_b - c.point_b).norm() / L});
+}
+
+TEST(CollisionDistance, ContactReadOffTheNormalAgreesWithTheColdSolve) {
+  Rng r(101);
+  Tally ell, mix, sq;
+  int declined = 0, asked = 0;
+  const int n = scaled_count(2000, 0.05);
+  for (int k = 0; k < n; ++k) {
+    const Ellipsoid a = r.ellipsoid(10.0), b = r.ellipsoid(10.0);
+    check_touch(r, a, b, true, k, ell, declined);
+    const Sphere s{r.uni(0.1, 2.0)};
+    if (k % 2) check_touch(r, a, s, true, k, mix, declined);
+    else check_touch(r, s, a, true, k, mix, declined);
+    const double e = k % 8 < 4 ? 4.0 : 8.0;
+    const Superquadric qa{r.uni(0.5, 2.0), r.uni(0.5, 2.0), r.uni(0.3, 1.0), e, e, e};
+    const Superquadric qb{r.uni(0.5, 2.0), r.uni(0.3, 1.0), r.uni(0.3, 1.0), 2.0, 2.0, e};
+    check_touch(r, qa, qb, false, k, sq, declined);
+    asked += k % 4 >= 2 ? 3 : 0;
+  }
+  report("read off the normal: ellipsoids", ell);
+  report("read off the normal: ellipsoid and sphere", mix);
+  report("read off the normal: superquadrics", sq);
+  std::printf("  declined %d of %d pairs apart or along a tilted axis\n", declined, asked);
+  for (const Tally* t : {&ell, &mix}) {
+    EXPECT_LE(t->dist, 1e-11);
+    EXPECT_LE(t->normal, 1e-7);
+    EXPECT_LE(t->points, 1e-6);
+  }
+  EXPECT_LE(sq.dist, 1e-10);
+  EXPECT_EQ(declined, asked);
+}
+
 }  // namespace
 }  // namespace hb
