@@ -176,6 +176,12 @@ struct ContactInput {
   // centres); e.g. the pair's axis of its last solve (ContactResult::axis).  Any unit vector
   // is a valid start: it only changes how many steps the search takes.
   Vec3 axis_start = Vec3::Zero();
+  // The solver's first test, the bounding spheres' window in [t_start, t_max] (radius L_A + L_B
+  // plus bounding_window_margin, no growth), already done by the caller on these same numbers
+  // with this answer [window_lo, window_hi] (non-empty): not repeated (predict_contacts' first
+  // pre-filter, system/rigid_bodies.hpp).
+  bool window_given = false;
+  double window_lo = 0.0, window_hi = 0.0;
 };
 
 struct ContactOptions {
@@ -850,10 +856,12 @@ struct Solver {
       failed = true;  // the scale law must stay positive over the window
       return;
     }
+    if (in.window_given && !grow) lo = in.window_lo, hi = in.window_hi;
     const bool window =
-        grow ? bounding_sphere_window(in.a, in.b, in.t_state, Lab * in.growth.s + margin,
-                                      Lab * in.growth.rate, lo, hi)
-             : bounding_sphere_window(in.a, in.b, in.t_state, Lab + margin, lo, hi);
+        (in.window_given && !grow) ||
+        (grow ? bounding_sphere_window(in.a, in.b, in.t_state, Lab * in.growth.s + margin,
+                                       Lab * in.growth.rate, lo, hi)
+              : bounding_sphere_window(in.a, in.b, in.t_state, Lab + margin, lo, hi));
     if (!(lo <= hi) || !window) {
       out.status = ContactStatus::none;
       return;

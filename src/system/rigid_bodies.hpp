@@ -57,6 +57,8 @@ struct SolverStats {
     distance_fallbacks += r.distance_fallbacks;
     if (r.status == ContactStatus::hit) ++hits, hit_distance_evals += r.distance_evals;
   }
+  // add(ContactResult{}) without building one: a prediction answered "none" with no work.
+  void add_none() { ++predictions; }
 };
 
 // A contact-time solve that failed (every fallback exhausted): carries a reproducer in the
@@ -211,15 +213,18 @@ bool clear_along_memo_or_centres(const SA& A, const SB& B, const State& s, std::
 // The prediction loop of the rigid pair models (RigidBodies, RigidMixture): body i (at `now`)
 // against the candidates js (at their images `shifts`, or the minimum image), each window cut at
 // the candidate's horizon, at law_end (where the growth law changes) and, with `trim`, at the
-// earliest contact found so far (later ones are not needed). solve(a, b, j, horizon) runs the
-// pair's contact-time solver; a failed solve throws SolverFailure(fail(a, b, j, horizon)).
-// window_radius > 0: the radius the solver's own first test uses (contact_time.hpp: the
-// bounding spheres' sum plus its margin), a number for one shape (RigidBodies) or radius(j) for
-// candidate j (RigidMixture: at least the solver's radius, see there). A candidate whose
-// bounding spheres cannot meet within its window is then rejected here, from its position
-// alone, before its orientation is streamed to `now` and a solver is set up: the same test on
-// the same numbers (or on a radius no smaller), so the same result (counted as the prediction
-// it replaces, and in stats.prefiltered). A candidate that passes it is offered to
+// earliest contact found so far (later ones are not needed). solve(a, b, j, horizon, window)
+// runs the pair's contact-time solver; a failed solve throws
+// SolverFailure(fail(a, b, j, horizon)). window_radius > 0: the radius the solver's own first
+// test uses (contact_time.hpp: the bounding spheres' sum plus its margin), a number for one
+// shape (RigidBodies) or radius(j) for candidate j (RigidMixture: at least the solver's radius,
+// see there). A candidate whose bounding spheres cannot meet within its window is then rejected
+// here, from its position alone, before its orientation is streamed to `now` and a solver is
+// set up: the same test on the same numbers (or on a radius no smaller), so the same result
+// (counted as the prediction it replaces, and in stats.prefiltered). With a number (the
+// solver's own radius) the window it found, {lo, hi}, is handed to solve as `window`, for
+// ContactInput::window_given (the solver does not repeat the test); else window is null. A
+// candidate that passes it is offered to
 // clear(a, j, c, horizon) (c = r_j - r_i at `now`): true means no contact in the window, proven
 // without streaming j's orientation (the gap along the line of centres, clear_along_centres of
 // contact/axis_gap.hpp), so the solver, which would answer none, is not set up.
@@ -247,24 +252,28 @@ void predict_contacts(const State& s, const Box& box, std::uint32_t i, const std
     if (j == i || !(horizon > now)) continue;
     const Vec3 rj = s.r[j] + s.v[j] * (now - s.t[j]);  // as State::body_at streams it
     const Vec3 rb = shifts ? Vec3(rj + shifts[k]) : Vec3(a.r + box.near_image(rj - a.r));
+    const double* window = nullptr;  // the bounding spheres' window, when it is the solver's
+    double lohi[2];
     if (const double R = radius(j); R > 0.0) {
       BodyState b0;
       b0.r = rb, b0.v = s.v[j];
-      double lo = now, hi = horizon;
+      double& lo = lohi[0] = now;
+      double& hi = lohi[1] = horizon;
       if (!bounding_sphere_window(a, b0, now, R, lo, hi) || !(lo <= hi)) {
-        stats.add(ContactResult{});  // the solver's answer to this test: none
+        stats.add_none();  // the solver's answer to this test: none
         ++stats.prefiltered;
         continue;
       }
       if (clear(a, j, Vec3(rb - a.r), horizon)) {
-        stats.add(ContactResult{});  // no contact in the window: the solver's answer
+        stats.add_none();  // no contact in the window: the solver's answer
         ++stats.prefiltered, ++stats.centre_line_clears;
         continue;
       }
+      if constexpr (std::is_arithmetic_v<Radius>) window = lohi;  // the solver's own radius
     }
     BodyState b = s.body_at(j, now);
     b.r = rb;
-    const ContactResult r = solve(a, b, j, horizon);
+    const ContactResult r = solve(a, b, j, horizon, window);
     stats.add(r);
     if (r.status == ContactStatus::failed) throw SolverFailure(fail(a, b, j, horizon));
     if (r.status == ContactStatus::hit) {
@@ -355,9 +364,10 @@ struct RigidBodies {
     const double law_end = now < law.t_stop ? law.t_stop : kInf;  // the law changes there
     predict_contacts(
         s, box, i, js, shifts, n, now, horizons, out, law_end, trim_horizons, stats,
-        [&](const BodyState& a, const BodyState& b, std::uint32_t j, double horizon) {
+        [&](const BodyState& a, const BodyState& b, std::uint32_t j, double horizon, const double* window) {
           ContactInput<S, S> in{shape, shape, a, b, now, now, horizon, eps_d};
           in.growth = sl;
+          if (window) in.window_given = true, in.window_lo = window[0], in.window_hi = window[1];
           memo.find(i, j, in.axis_start);
           const ContactResult r = contact_time(in, options);
           memo.store(s.size(), i, j, r.status == ContactStatus::hit ? r.normal : r.axis);

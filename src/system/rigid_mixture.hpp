@@ -104,7 +104,7 @@ struct RigidMixture {
     const double law_end = now < law.t_stop ? law.t_stop : kInf;  // the law changes there
     predict_contacts(
         s, box, i, js, shifts, n, now, horizons, out, law_end, trim_horizons, stats,
-        [&](const BodyState& a, const BodyState& b, std::uint32_t j, double horizon) {
+        [&](const BodyState& a, const BodyState& b, std::uint32_t j, double horizon, const double*) {
           return std::visit(
               [&](const auto& A, const auto& B) {
                 using SA = std::decay_t<decltype(A)>;

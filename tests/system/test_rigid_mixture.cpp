@@ -205,8 +205,9 @@ namespace {
 
 // Every body of a running simulation of `model` (after 2000 events; the candidates each at their
 // own time) predicted against all the others twice by run(s, box, now, i, js, horizons, out,
-// stats, solve, fail, filtered), with and without a pre-filter of predict_contacts: the answers
-// must be the same bit for bit. horizon(i, j): the window lengths. The tallies of both passes.
+// stats, solve, fail, filtered), with and without a pre-filter of predict_contacts (with the
+// position pre-filter, the solver takes its window from it): the answers must be the same bit
+// for bit. horizon(i, j): the window lengths. The tallies of both passes.
 struct PrefilterTally {
   long solved_with = 0, solved_without = 0, hits = 0;
   SolverStats with, without;
@@ -229,9 +230,11 @@ PrefilterTally compare_prefilter(const RigidSystemSpec& spec, const RigidBodies<
     s.advance_to(i, now);
     for (std::uint32_t j = 0; j < n; ++j) js[j] = j, horizons[j] = now + horizon(i, j);
     auto solve = [&](long& count) {
-      return [&](const BodyState& x, const BodyState& y, std::uint32_t, double h) {
+      return [&](const BodyState& x, const BodyState& y, std::uint32_t, double h, const double* window) {
         ++count;
         ContactInput<Ellipsoid, Ellipsoid> in{model.shape, model.shape, x, y, now, now, h, model.eps_d};
+        // the pre-filter's window handed on (ContactInput::window_given), as RigidBodies does
+        if (window) in.window_given = true, in.window_lo = window[0], in.window_hi = window[1];
         return contact_time(in, model.options);
       };
     };
