@@ -856,12 +856,14 @@ struct Solver {
       failed = true;  // the scale law must stay positive over the window
       return;
     }
-    if (in.window_given && !grow) lo = in.window_lo, hi = in.window_hi;
-    const bool window =
-        (in.window_given && !grow) ||
-        (grow ? bounding_sphere_window(in.a, in.b, in.t_state, Lab * in.growth.s + margin,
-                                       Lab * in.growth.rate, lo, hi)
-              : bounding_sphere_window(in.a, in.b, in.t_state, Lab + margin, lo, hi));
+    bool window = true;
+    if (in.window_given && !grow)
+      lo = in.window_lo, hi = in.window_hi;  // the caller's answer to the same test
+    else if (grow)
+      window = bounding_sphere_window(in.a, in.b, in.t_state, Lab * in.growth.s + margin,
+                                      Lab * in.growth.rate, lo, hi);
+    else
+      window = bounding_sphere_window(in.a, in.b, in.t_state, Lab + margin, lo, hi);
     if (!(lo <= hi) || !window) {
       out.status = ContactStatus::none;
       return;

@@ -253,12 +253,11 @@ void predict_contacts(const State& s, const Box& box, std::uint32_t i, const std
     const Vec3 rj = s.r[j] + s.v[j] * (now - s.t[j]);  // as State::body_at streams it
     const Vec3 rb = shifts ? Vec3(rj + shifts[k]) : Vec3(a.r + box.near_image(rj - a.r));
     const double* window = nullptr;  // the bounding spheres' window, when it is the solver's
-    double lohi[2];
+    double lohi[2] = {now, horizon};
     if (const double R = radius(j); R > 0.0) {
       BodyState b0;
       b0.r = rb, b0.v = s.v[j];
-      double& lo = lohi[0] = now;
-      double& hi = lohi[1] = horizon;
+      double &lo = lohi[0], &hi = lohi[1];
       if (!bounding_sphere_window(a, b0, now, R, lo, hi) || !(lo <= hi)) {
         stats.add_none();  // the solver's answer to this test: none
         ++stats.prefiltered;
