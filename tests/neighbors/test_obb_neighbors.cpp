@@ -194,24 +194,31 @@ void expect_same_energy(const SimA& a, const SimB& b) {
   EXPECT_NEAR(ea, eb, 1e-12 * eb);
 }
 
+// A longer run of sim (to 20000 collisions in all): no overlaps at the end, energy conserved
+// to 1e-10 relative.
+template <class Sim>
+void expect_overlap_free_and_conservative(Sim& sim, const RigidSystemSpec& spec) {
+  const double e0 = sim.model().kinetic_energy(sim.state());
+  const std::uint64_t target = hb::testing::scaled_count(20000, 0.01);
+  while (sim.collisions() < target) sim.step(kInf);
+  sim.synchronize();
+  const double e1 = sim.model().kinetic_energy(sim.state());
+  const OverlapReport ov =
+      ellipsoid_overlaps(sim.state().r, sim.state().q, sim.box(), spec.semi_axes);
+  std::printf("[ NNL ] %llu collisions: overlaps %lu, min gap %.3e, relative energy drift %.2e\n",
+              (unsigned long long)sim.collisions(), (unsigned long)ov.overlaps, ov.min_distance,
+              std::abs(e1 - e0) / e0);
+  EXPECT_EQ(ov.overlaps, 0u);
+  EXPECT_LT(std::abs(e1 - e0) / e0, 1e-10);
+}
+
 TEST(ObbNeighbors, SameCollisionsAsCellListsOverlapFreeAndConservative) {
   RigidSystemSpec spec;
   spec.seed = 11;
   auto cells = make_ellipsoid_cell_simulation(spec);
   auto nnl = make_ellipsoid_nnl_simulation(spec, 0.15);
   expect_same_collisions(cells, nnl, hb::testing::scaled_count(1000, 0.05), "cell lists");
-  // longer run: no overlaps, energy conserved
-  const double e0 = nnl.model().kinetic_energy(nnl.state());
-  const std::uint64_t target = hb::testing::scaled_count(20000, 0.01);
-  while (nnl.collisions() < target) nnl.step(kInf);
-  nnl.synchronize();
-  const double e1 = nnl.model().kinetic_energy(nnl.state());
-  const OverlapReport ov =
-      ellipsoid_overlaps(nnl.state().r, nnl.state().q, nnl.box(), spec.semi_axes);
-  std::printf("[ NNL ] 20000 collisions: overlaps %lu, min gap %.3e, relative energy drift %.2e\n",
-              (unsigned long)ov.overlaps, ov.min_distance, std::abs(e1 - e0) / e0);
-  EXPECT_EQ(ov.overlaps, 0u);
-  EXPECT_LT(std::abs(e1 - e0) / e0, 1e-10);
+  expect_overlap_free_and_conservative(nnl, spec);
 }
 
 // The fast paths of the prediction (per-pair horizons from the calendar, stopping at the
@@ -308,17 +315,7 @@ TEST(ObbNeighbors, ContactsReadOffTheMemoAxisGiveTheSameCollisions) {
               (unsigned long long)solve.model().stats.collision_touches);
   EXPECT_EQ(solve.model().stats.collision_touches, 0u);
   EXPECT_GT(touches, fast.collisions() * 9 / 10);
-  const double e0 = fast.model().kinetic_energy(fast.state());
-  const std::uint64_t target = hb::testing::scaled_count(20000, 0.01);
-  while (fast.collisions() < target) fast.step(kInf);
-  fast.synchronize();
-  const double e1 = fast.model().kinetic_energy(fast.state());
-  const OverlapReport ov = ellipsoid_overlaps(fast.state().r, fast.state().q, fast.box(), spec.semi_axes);
-  std::printf("[ NNL ] %llu collisions: overlaps %lu, min gap %.3e, relative energy drift %.2e\n",
-              (unsigned long long)fast.collisions(), (unsigned long)ov.overlaps, ov.min_distance,
-              std::abs(e1 - e0) / e0);
-  EXPECT_EQ(ov.overlaps, 0u);
-  EXPECT_LT(std::abs(e1 - e0) / e0, 1e-10);
+  expect_overlap_free_and_conservative(fast, spec);
 }
 
 // A run continued from its snapshot (the loop, the neighbour boxes and the axis memo, as a
