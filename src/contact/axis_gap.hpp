@@ -390,41 +390,83 @@ Vec3 separating_axis_at(const SA& sa, const Quat& rot_a, const SB& sb, const Qua
 // bodies A and B, of fixed shape, touch in [now, now + span]? A is at `now` (orientation qa,
 // lab angular velocity wa); B's centre is streamed to `now` (separation c = r_B - r_A) but its
 // orientation qb and angular velocity wb are the stored ones, `age` = now - t_B before;
-// dv = v_B - v_A. A support value along a fixed lab direction u changes at most at
-// l |w(t) x u| (the rate bound of AxisGap above, l the rotation lever). For a spherical top w
-// is constant; for any other top w(t) turns, and l |w(t)| <= l wmax bounds the rate instead
-// (wmax the top's largest angular speed, FreeRotation::max_angular_speed; pass wmax < 0 for a
-// spherical top). With these turn rates T_A, T_B and a fixed unit direction u (clear_along_axis;
-// clear_along_centres takes u = c / |c|, so that u.c = |c|),
-//     g_u(now) >= u.c - h_A(R_A^T u) - h_B(-R_B(t_B)^T u) - T_B age,
-// and g_u falls at most at K_u = |u.dv| + T_A + T_B, so g_u(now) > K_u span keeps g_u, hence
-// the distance, positive over the window: true means no contact there (the answer the
-// contact-time solver would give; false: not decided). The margin 1e-10 (L_A + L_B) covers
-// rounding. This is the solver's first test along the line of centres, which alone rules out
-// 42 % of the candidates that pass the bounding spheres in an ellipsoid fluid (phi = 0.5,
-// X0 = 2, NNL, spherical tops).
+// dv = v_B - v_A. Each body's rotation enters through SpinBound: a spherical top (wmax < 0)
+// turns a fixed lab direction u in its frame at |m'| = |w x u| =: s with |m''| = |w| s; any
+// other top at |m'| <= wmax, |m''| <= wmax^2 + dwmax (its largest angular speed and the bound
+// of |dW/dt|, motion/motion.hpp; AxisGap above derives both).
+//
+// First order. A support value along u changes at most at l |m'| (the rate bound of AxisGap
+// above, l the rotation lever), so with these turn rates T_A, T_B,
+//     g_u(now) >= g1 := u.c - h_A(R_A^T u) - h_B(-R_B(t_B)^T u) - T_B age,
+// and g_u falls at most at K_u = |u.dv| + T_A + T_B: g_u(now + tau) >= g1 - K_u tau.
+//
+// Second order (second_order = true, pairs whose curvature radii are bounded: ellipsoids,
+// spheres). The support function's rate is exact at one instant: dh/dt = (w x p).u for the
+// lab support point p (envelope theorem: h = max (R x).u, R' = [w]x R), and |d^2h/dt^2| <=
+// M = rho |m'|^2 + L |m''| (rho the largest radius of curvature, L the bounding radius; AxisGap's
+// curvature bound). Taylor's theorem for A from `now` and for B from t_B, whose orientation is
+// the stored one:
+//     g_u(now + tau) >= Q(tau) := u.c + u.dv tau - [h_A + r_A tau + M_A tau^2 / 2]
+//                                 - [h_B(t_B) + r_B (age + tau) + M_B (age + tau)^2 / 2],
+// r_A = (w_A x p_A).u at now, r_B = -(w_B x p_B).u at t_B. Q is a concave parabola in tau.
+//
+// Both lines bound g_u over the whole window, so g_u stays positive where either does: the
+// first-order line up to t1 = g1 / K_u, Q beyond it (a concave Q is above a level on [t1, span]
+// if it is at both ends). True means g_u, hence the distance, stays positive over the window:
+// no contact there (the answer the contact-time solver would give; false: not decided). The
+// margin 1e-10 (L_A + L_B) covers rounding. The first-order test along the line of centres
+// alone rules out 42 % of the candidates that pass the bounding spheres in an ellipsoid fluid
+// (phi = 0.5, X0 = 2, NNL, spherical tops); the second order along the pair's last axis (the
+// memo) rules out half of those left for the solver at X0 = 10 (phi = 0.4), where the turn
+// of a long body spoils the first-order line (docs/benchmarks/README.md).
+struct SpinBound {
+  double wmax = -1.0;  // < 0: a spherical top (w constant); else the largest angular speed
+  double dwmax = 0.0;  // a bound of |dW/dt| (not spherical tops)
+};
 template <SupportShape SA, SupportShape SB>
 bool clear_along_axis(const SA& sa, const Quat& qa, const Vec3& wa, const SB& sb, const Quat& qb,
                       const Vec3& wb, const Vec3& c, const Vec3& u, const Vec3& dv, double age,
-                      double span, double wmax_a = -1.0, double wmax_b = -1.0) {
+                      double span, SpinBound spin_a = {}, SpinBound spin_b = {},
+                      bool second_order = false) {
   if (!(span < kInf)) return false;
-  auto turn = [&u](double lever, const Vec3& w, double wmax) {
-    return wmax < 0.0 ? lever * w.cross(u).norm() : lever * wmax;
+  auto turn_speed = [&u](const Vec3& w, SpinBound spin) {  // a bound of |m'|
+    return spin.wmax < 0.0 ? w.cross(u).norm() : spin.wmax;
   };
-  const double turn_a = turn(rotation_lever(sa), wa, wmax_a);
-  const double turn_b = turn(rotation_lever(sb), wb, wmax_b);
-  const double g = u.dot(c) - sa.support(qa.conjugate() * u) -
-                   sb.support(qb.conjugate() * Vec3(-u)) - turn_b * age;
+  const double sw_a = turn_speed(wa, spin_a), sw_b = turn_speed(wb, spin_b);
+  const double turn_a = rotation_lever(sa) * sw_a, turn_b = rotation_lever(sb) * sw_b;
+  const Vec3 ma = qa.conjugate() * u, mb = qb.conjugate() * Vec3(-u);
+  const double g_old = u.dot(c) - sa.support(ma) - sb.support(mb);  // B as it was at t_B
+  const double g = g_old - turn_b * age;
   const double Ku = std::abs(u.dot(dv)) + turn_a + turn_b;
-  return g - Ku * span > 1e-10 * (sa.bounding_radius() + sb.bounding_radius());
+  const double margin = 1e-10 * (sa.bounding_radius() + sb.bounding_radius());
+  if (g - Ku * span > margin) return true;
+  if constexpr (AxisGap<SA, SB>::kMayCurve) {
+    if (!second_order || !AxisGap<SA, SB>::curved(sa, sb)) return false;
+    const double t1 = g > margin && Ku > 0.0 ? (g - margin) / Ku : 0.0;  // first order holds up to here
+    const Vec3 pa = qa * sa.support_point(ma), pb = qb * sb.support_point(mb);
+    const double ra = wa.cross(pa).dot(u), rb = -wb.cross(pb).dot(u);
+    auto curvature = [](const auto& shape, const Vec3& w, SpinBound spin, double sw) {
+      const double mdd = spin.wmax < 0.0 ? w.norm() * sw : sw * sw + spin.dwmax;  // |m''|
+      return shape.max_curvature_radius() * sw * sw + shape.bounding_radius() * mdd;
+    };
+    const double Ma = curvature(sa, wa, spin_a, sw_a), Mb = curvature(sb, wb, spin_b, sw_b);
+    const double q0 = g_old - age * (rb + 0.5 * Mb * age);
+    const double q1 = u.dot(dv) - ra - rb - Mb * age;
+    const double q2 = 0.5 * (Ma + Mb);
+    auto Q = [&](double tau) { return q0 + tau * (q1 - q2 * tau); };
+    return Q(t1) > margin && Q(span) > margin;
+  }
+  return false;
 }
 template <SupportShape SA, SupportShape SB>
 bool clear_along_centres(const SA& sa, const Quat& qa, const Vec3& wa, const SB& sb,
                          const Quat& qb, const Vec3& wb, const Vec3& c, const Vec3& dv,
-                         double age, double span, double wmax_a = -1.0, double wmax_b = -1.0) {
+                         double age, double span, SpinBound spin_a = {}, SpinBound spin_b = {},
+                         bool second_order = false) {
   const double cn = c.norm();
   if (!(cn > 0.0)) return false;
-  return clear_along_axis(sa, qa, wa, sb, qb, wb, c, Vec3(c / cn), dv, age, span, wmax_a, wmax_b);
+  return clear_along_axis(sa, qa, wa, sb, qb, wb, c, Vec3(c / cn), dv, age, span, spin_a, spin_b,
+                          second_order);
 }
 
 template <SupportShape SA, SupportShape SB>

@@ -30,6 +30,16 @@
 
 namespace hb {
 
+// A bound of |dW/dt| (W the body-frame angular velocity) for a free top of principal moments
+// `top` whose angular speed stays below wmax. From Euler's equations I_i W_i' = (I_j - I_k) W_j W_k:
+// with c the largest |I_j - I_k| / I_i, |W'|^2 <= c^2 sum_{j<k} W_j^2 W_k^2 <= c^2 |W|^4 / 3.
+inline double angular_acceleration_bound(const Vec3& top, double wmax) {
+  const Vec3& I = top;
+  const double c = std::max({std::abs(I[1] - I[2]) / I[0], std::abs(I[2] - I[0]) / I[1],
+                             std::abs(I[0] - I[1]) / I[2]});
+  return c * wmax * wmax / std::sqrt(3.0);
+}
+
 class Motion {
  public:
   explicit Motion(const BodyState& b) : b_(b) {
@@ -43,12 +53,7 @@ class Motion {
         rot_ = &*own_;
       }
       wmax_ = rot_->max_angular_speed();
-      // |dW/dt| from Euler's equations I_i W_i' = (I_j - I_k) W_j W_k: with c the largest
-      // |I_j - I_k| / I_i, |W'|^2 <= c^2 sum_{j<k} W_j^2 W_k^2 <= c^2 |W|^4 / 3.
-      const Vec3& I = b.top;
-      const double c = std::max({std::abs(I[1] - I[2]) / I[0], std::abs(I[2] - I[0]) / I[1],
-                                 std::abs(I[0] - I[1]) / I[2]});
-      dwmax_ = c * wmax_ * wmax_ / std::sqrt(3.0);
+      dwmax_ = angular_acceleration_bound(b.top, wmax_);
     }
   }
 

@@ -182,12 +182,19 @@ struct NeverClear {
   bool operator()(const BodyState&, std::uint32_t, const Vec3&, double) const { return false; }
 };
 
-// The largest angular speed of a body's free rotation for clear_along_centres: -1 for a
-// spherical top (w constant: the test uses w itself), else that of its free rotation (the one
-// the State caches and the solver evaluates).
-inline double max_spin(const BodyState& a) { return a.rot ? a.rot->max_angular_speed() : -1.0; }
-inline double max_spin(const State& s, std::uint32_t j) {
-  return spherical_top(s.top(j)) ? -1.0 : s.free_rotation(j).max_angular_speed();
+// A body's rotation for the pre-filters (SpinBound of contact/axis_gap.hpp): wmax = -1 for a
+// spherical top (w constant: the tests use w itself), else the largest angular speed of its
+// free rotation (the one the State caches and the solver evaluates) and the bound of |dW/dt|
+// the solver's Motion takes from it.
+inline SpinBound spin_bound(const BodyState& a) {
+  if (!a.rot) return {};
+  const double w = a.rot->max_angular_speed();
+  return {w, angular_acceleration_bound(a.top, w)};
+}
+inline SpinBound spin_bound(const State& s, std::uint32_t j) {
+  if (spherical_top(s.top(j))) return {};
+  const double w = s.free_rotation(j).max_angular_speed();
+  return {w, angular_acceleration_bound(s.top(j), w)};
 }
 
 // The second pre-filter of the rigid models (predict_contacts' `clear`): body i (shape A, state
@@ -197,17 +204,23 @@ inline double max_spin(const State& s, std::uint32_t j) {
 // axis gives a valid bound. The answer is the same in either order; the memo's axis comes first
 // because it separates more often (the pair's best axis a few events ago), so the second test
 // runs less often (measured: docs/benchmarks/README.md, "Session of 2026-11-29, sixth part").
+// The first axis tried gets the second-order bound too (curved pairs): it clears half the
+// candidates the first order leaves to the solver at X0 = 10; along the line of centres after
+// the memo's axis it would clear few more than it costs.
 template <class SA, class SB>
 bool clear_along_memo_or_centres(const SA& A, const SB& B, const State& s, std::uint32_t i,
                                  const BodyState& a, std::uint32_t j, const Vec3& c, double now,
                                  double horizon, const AxisMemo& memo) {
   const Vec3 dv = s.v[j] - a.v;
-  const double wa = max_spin(a), wb = max_spin(s, j), age = now - s.t[j], span = horizon - now;
+  const SpinBound wa = spin_bound(a), wb = spin_bound(s, j);
+  const double age = now - s.t[j], span = horizon - now;
   Vec3 u;
-  if (memo.find(i, j, u) &&
-      clear_along_axis(A, a.q, a.w, B, s.q[j], s.w[j], c, Vec3(u.normalized()), dv, age, span, wa, wb))
+  const bool remembered = memo.find(i, j, u);
+  if (remembered && clear_along_axis(A, a.q, a.w, B, s.q[j], s.w[j], c, Vec3(u.normalized()), dv,
+                                     age, span, wa, wb, /*second_order=*/true))
     return true;
-  return clear_along_centres(A, a.q, a.w, B, s.q[j], s.w[j], c, dv, age, span, wa, wb);
+  return clear_along_centres(A, a.q, a.w, B, s.q[j], s.w[j], c, dv, age, span, wa, wb,
+                             /*second_order=*/!remembered);
 }
 
 // The prediction loop of the rigid pair models (RigidBodies, RigidMixture): body i (at `now`)

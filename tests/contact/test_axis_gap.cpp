@@ -124,6 +124,26 @@ void check_lower_bound(std::uint64_t seed, bool tops) {
 TEST(AxisGap, IsALowerBoundOfTheDistanceAndExactAlongTheNormal) { check_lower_bound(43, false); }
 TEST(AxisGap, AsymmetricTopsLowerBound) { check_lower_bound(71, true); }
 
+// A case for the pre-filters of the prediction loop: a random pair (near contact to 2 apart) at
+// B's stored time 0, and `now` = age later, A's orientation and angular velocity streamed there
+// (qa, wa), the centre separation c at now; a window of up to 0.5 from now.
+struct ClearCase {
+  Pair p;
+  Motion ma, mb;
+  double age, span;
+  Vec3 c, wa;
+  Quat qa;
+};
+ClearCase clear_case(Rng& r, bool tops) {
+  const Pair p = random_pair(r, r.log_uni(1e-3, 2.0), tops);
+  const Motion ma(p.sa), mb(p.sb);
+  const double age = r.uni(0.0, 0.3), span = r.log_uni(1e-3, 0.5);
+  Quat qa;
+  Vec3 wa;
+  ma.pose(age, qa, wa);
+  return ClearCase{p, ma, mb, age, span, Vec3(mb.position(age) - ma.position(age)), wa, qa};
+}
+
 // clear_along_centres, the prediction loop's pre-filter, against the gap along the line of
 // centres itself: B's orientation is the one it had `age` before `now`; for sampled times t in
 // the window, g_u(t) (true orientations of both at t) must stay above the test's straight line
@@ -137,14 +157,9 @@ void check_clear_along_centres(std::uint64_t seed, bool tops) {
   int cleared = 0;
   double worst = -kInf;
   for (int k = 0; k < n; ++k) {
-    const Pair p = random_pair(r, r.log_uni(1e-3, 2.0), tops);
-    const Motion ma(p.sa), mb(p.sb);
-    const double age = r.uni(0.0, 0.3), span = r.log_uni(1e-3, 0.5);
-    const Vec3 c = mb.position(age) - ma.position(age);
+    const ClearCase cc = clear_case(r, tops);
+    const auto& [p, ma, mb, age, span, c, wa, qa] = cc;
     const Vec3 u = c.normalized();
-    Quat qa;
-    Vec3 wa;
-    ma.pose(age, qa, wa);
     const double wmax_a = tops ? ma.max_angular_speed() : -1.0;
     const double wmax_b = tops ? mb.max_angular_speed() : -1.0;
     const Vec3 dv = p.sb.v - p.sa.v;
@@ -156,7 +171,7 @@ void check_clear_along_centres(std::uint64_t seed, bool tops) {
                       p.b.support(p.sb.q.conjugate() * Vec3(-u)) - tb * age;
     const double Ku = std::abs(u.dot(dv)) + turn(la, wa, wmax_a) + tb;
     const bool clear = clear_along_centres(p.a, qa, wa, p.b, p.sb.q, p.sb.w, c, dv, age, span,
-                                           wmax_a, wmax_b);
+                                           SpinBound{wmax_a}, SpinBound{wmax_b});
     EXPECT_EQ(clear, g0 - Ku * span > 1e-10 * (p.a.bounding_radius() + p.b.bounding_radius()));
     cleared += clear;
     for (int m = 0; m <= 20; ++m) {
@@ -180,6 +195,71 @@ void check_clear_along_centres(std::uint64_t seed, bool tops) {
 TEST(AxisGap, ClearAlongCentresIsBelowTheGapAlongThem) { check_clear_along_centres(83, false); }
 TEST(AxisGap, ClearAlongCentresIsBelowTheGapAlongThemForAsymmetricTops) {
   check_clear_along_centres(89, true);
+}
+
+// The second-order bound of clear_along_axis (second_order = true), against the gap along its
+// axis itself. The test rebuilds the parabola Q from independent parts: the support functions'
+// rates by central differences of h(R(t)^T u) (A at now, B at its own time, `age` before), and
+// the curvature bound M = rho |m'|^2 + L |m''| of the header; Q(tau) must stay below g_u(now +
+// tau) over the window (the Taylor bound and M hold), and wherever the test says clear, g_u
+// and the distance stay positive. Axes: the line of centres, or one tilted from it by up to 0.3
+// rad (as a remembered axis is); ellipsoids of aspect up to 5, spherical or asymmetric tops.
+// The second order must clear every pair the first order clears, and more.
+void check_second_order_clear(std::uint64_t seed, bool tops) {
+  Rng r(seed);
+  const int n = scaled_count(2000, 0.1);
+  int first = 0, second = 0;
+  double worst = -kInf;
+  for (int k = 0; k < n; ++k) {
+    const ClearCase cc = clear_case(r, tops);
+    const auto& [p, ma, mb, age, span, c, wa, qa] = cc;
+    Vec3 u = c.normalized();
+    if (k % 2) u = (Eigen::AngleAxisd(r.uni(0.0, 0.3), r.unit()) * u).normalized();
+    const SpinBound spin_a = tops ? SpinBound{ma.max_angular_speed(), ma.max_angular_acceleration()} : SpinBound{};
+    const SpinBound spin_b = tops ? SpinBound{mb.max_angular_speed(), mb.max_angular_acceleration()} : SpinBound{};
+    const Vec3 dv = p.sb.v - p.sa.v;
+    const bool lin = clear_along_axis(p.a, qa, wa, p.b, p.sb.q, p.sb.w, c, u, dv, age, span, spin_a, spin_b);
+    const bool quad =
+        clear_along_axis(p.a, qa, wa, p.b, p.sb.q, p.sb.w, c, u, dv, age, span, spin_a, spin_b, true);
+    if (lin) {
+      EXPECT_TRUE(quad) << k;
+    }
+    first += lin, second += quad;
+    // Q from central differences of the support functions and the header's M
+    auto ha = [&](double t) { return p.a.support(ma.orientation(t).conjugate() * u); };
+    auto hb = [&](double t) { return p.b.support(mb.orientation(t).conjugate() * Vec3(-u)); };
+    const double d = 1e-6, ra = (ha(age + d) - ha(age - d)) / (2 * d), rb = (hb(d) - hb(-d)) / (2 * d);
+    auto M = [&](const Ellipsoid& e, const Vec3& w, const Motion& m) {
+      const double sw = tops ? m.max_angular_speed() : w.cross(u).norm();
+      const double mdd = tops ? sw * sw + m.max_angular_acceleration() : w.norm() * sw;
+      return e.max_curvature_radius() * sw * sw + e.bounding_radius() * mdd;
+    };
+    const double Ma = M(p.a, wa, ma), Mb = M(p.b, p.sb.w, mb);
+    for (int m = 0; m <= 40; ++m) {
+      const double tau = span * m / 40.0, t = age + tau;
+      const Vec3 ct = mb.position(t) - ma.position(t);
+      const double gu = u.dot(ct) - ha(t) - hb(t);
+      const double Q = u.dot(c) + u.dot(dv) * tau - (ha(age) + ra * tau + 0.5 * Ma * tau * tau) -
+                       (hb(0.0) + rb * (age + tau) + 0.5 * Mb * (age + tau) * (age + tau));
+      worst = std::max(worst, Q - gu);
+      if (quad) {
+        EXPECT_GT(gu, 0.0) << k << " " << t;
+        if (m % 10 == 0) {
+          EXPECT_GT(reference_distance_at(p, t), 0.0) << k << " " << t;
+        }
+      }
+    }
+  }
+  std::printf("  %d pairs%s: %d clear to first order, %d with the second, max (Q - g_u) %.2e\n", n,
+              tops ? " (asymmetric tops)" : "", first, second, worst);
+  EXPECT_LE(worst, 1e-8);  // central differences: rates to ~1e-10
+  EXPECT_GT(second, first + n / 50);
+  EXPECT_LT(second, n);
+}
+
+TEST(AxisGap, SecondOrderClearIsBelowTheGapAlongItsAxis) { check_second_order_clear(97, false); }
+TEST(AxisGap, SecondOrderClearIsBelowTheGapAlongItsAxisForAsymmetricTops) {
+  check_second_order_clear(101, true);
 }
 
 TEST(AxisGap, SeparatingAxisSearchApproachesTheDistance) {
