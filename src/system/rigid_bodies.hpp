@@ -204,6 +204,9 @@ inline SpinBound spin_bound(const State& s, std::uint32_t j) {
 // axis gives a valid bound. The answer is the same in either order; the memo's axis comes first
 // because it separates more often (the pair's best axis a few events ago), so the second test
 // runs less often (measured: docs/benchmarks/README.md, "Session of 2026-11-29, sixth part").
+// The memo's axis is either side's (AxisMemo::find_either): j's slot for i when i's own slot
+// holds another partner, as the solver's axis_start (-3.0 % instructions at X0 = 2, phi = 0.5,
+// -6.6 % at X0 = 10, phi = 0.4, against i's slot alone).
 // The first axis tried gets the second-order bound too (curved pairs): it clears half the
 // candidates the first order leaves to the solver at X0 = 10; along the line of centres after
 // the memo's axis it would clear few more than it costs.
@@ -215,7 +218,7 @@ bool clear_along_memo_or_centres(const SA& A, const SB& B, const State& s, std::
   const SpinBound wa = spin_bound(a), wb = spin_bound(s, j);
   const double age = now - s.t[j], span = horizon - now;
   Vec3 u;
-  const bool remembered = memo.find(i, j, u);
+  const bool remembered = memo.find_either(i, j, u);
   if (remembered && clear_along_axis(A, a.q, a.w, B, s.q[j], s.w[j], c, Vec3(u.normalized()), dv,
                                      age, span, wa, wb, /*second_order=*/true))
     return true;
@@ -380,7 +383,7 @@ struct RigidBodies {
           ContactInput<S, S> in{shape, shape, a, b, now, now, horizon, eps_d};
           in.growth = sl;
           if (window) in.window_given = true, in.window_lo = window[0], in.window_hi = window[1];
-          memo.find(i, j, in.axis_start);
+          memo.find_either(i, j, in.axis_start);
           const ContactResult r = contact_time(in, options);
           memo.store(s.size(), i, j, r.status == ContactStatus::hit ? r.normal : r.axis);
           return r;

@@ -111,7 +111,7 @@ struct RigidMixture {
                 using SB = std::decay_t<decltype(B)>;
                 ContactInput<SA, SB> in{A, B, a, b, now, now, horizon, eps_d};
                 in.growth = sl;
-                memo.find(i, j, in.axis_start);
+                memo.find_either(i, j, in.axis_start);
                 const ContactResult r = contact_time(in, options);
                 memo.store(s.size(), i, j, r.status == ContactStatus::hit ? r.normal : r.axis);
                 return r;
