@@ -199,17 +199,17 @@ inline SpinBound spin_bound(const State& s, std::uint32_t j) {
 
 // The second pre-filter of the rigid models (predict_contacts' `clear`): body i (shape A, state
 // a at `now`) and candidate j (shape B, centre separation c at `now`, orientation at its own
-// time) cannot touch before `horizon` by the gap along the pair's last separating axis in the
-// memo (clear_along_axis), or else along their line of centres (clear_along_centres): any fixed
-// axis gives a valid bound. The answer is the same in either order; the memo's axis comes first
-// because it separates more often (the pair's best axis a few events ago), so the second test
-// runs less often (measured: docs/benchmarks/README.md, "Session of 2026-11-29, sixth part").
-// The memo's axis is either side's (AxisMemo::find_either): j's slot for i when i's own slot
-// holds another partner, as the solver's axis_start (-3.0 % instructions at X0 = 2, phi = 0.5,
-// -6.6 % at X0 = 10, phi = 0.4, against i's slot alone).
-// The first axis tried gets the second-order bound too (curved pairs): it clears half the
-// candidates the first order leaves to the solver at X0 = 10; along the line of centres after
-// the memo's axis it would clear few more than it costs.
+// time) cannot touch before `horizon` by the gap along one fixed axis (clear_along_axis, to
+// first and second order; any fixed axis gives a valid bound): the pair's last separating axis
+// in the memo, either side's slot (AxisMemo::find_either, as the solver's axis_start), or, for
+// a pair not in the memo, their line of centres (clear_along_centres).
+// Measured (callgrind, docs/benchmarks/README.md, "Session of 2026-11-29, eighth part"):
+// - the second order along the memo's axis clears half the candidates the first order leaves
+//   to the solver at X0 = 10, phi = 0.4 (-9.4 % instructions there, -4.6 % at X0 = 2, phi = 0.5);
+// - either side's slot instead of i's own: -6.6 % at X0 = 10, -3.0 % at X0 = 2;
+// - with the second order along the memo's axis, the line of centres after it (first order;
+//   it came second since the sixth part) clears too few to pay for itself: -2.7 % at X0 = 2
+//   without it, no change at X0 = 10.
 template <class SA, class SB>
 bool clear_along_memo_or_centres(const SA& A, const SB& B, const State& s, std::uint32_t i,
                                  const BodyState& a, std::uint32_t j, const Vec3& c, double now,
@@ -218,12 +218,11 @@ bool clear_along_memo_or_centres(const SA& A, const SB& B, const State& s, std::
   const SpinBound wa = spin_bound(a), wb = spin_bound(s, j);
   const double age = now - s.t[j], span = horizon - now;
   Vec3 u;
-  const bool remembered = memo.find_either(i, j, u);
-  if (remembered && clear_along_axis(A, a.q, a.w, B, s.q[j], s.w[j], c, Vec3(u.normalized()), dv,
-                                     age, span, wa, wb, /*second_order=*/true))
-    return true;
+  if (memo.find_either(i, j, u))
+    return clear_along_axis(A, a.q, a.w, B, s.q[j], s.w[j], c, Vec3(u.normalized()), dv, age,
+                            span, wa, wb, /*second_order=*/true);
   return clear_along_centres(A, a.q, a.w, B, s.q[j], s.w[j], c, dv, age, span, wa, wb,
-                             /*second_order=*/!remembered);
+                             /*second_order=*/true);
 }
 
 // The prediction loop of the rigid pair models (RigidBodies, RigidMixture): body i (at `now`)
@@ -357,7 +356,7 @@ struct RigidBodies {
   // Use the loop's per-pair horizons and stop at the earliest contact found (false: every
   // candidate is solved without any horizon; the slow twin the tests compare against).
   bool trim_horizons = true;
-  // Rule out candidates by the gap along the line of centres before streaming their
+  // Rule out candidates by the gap along one axis (the memo's, or the line of centres) before streaming their
   // orientation (centre_line_clear; false: every candidate that passes the bounding spheres
   // goes to the solver, the slow twin of the tests).
   bool centre_line_test = true;
@@ -402,8 +401,8 @@ struct RigidBodies {
   }
   // The pre-filter of predict_contacts after the bounding spheres (no growth): body i (state a
   // at `now`) and candidate j (centre separation c at `now`, orientation at its own time) cannot
-  // touch before `horizon` by the gap along the pair's last separating axis (the memo), then, if
-  // that does not decide, along their line of centres (clear_along_memo_or_centres,
+  // touch before `horizon` by the gap along the pair's last separating axis (the memo), or, for
+  // a pair not in it, along their line of centres (clear_along_memo_or_centres,
   // contact/axis_gap.hpp; for tops that are not spherical with their largest angular speeds,
   // from the free rotation the solver uses); false when off (centre_line_test, the slow twin)
   // or not decided.

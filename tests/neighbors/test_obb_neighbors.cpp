@@ -377,14 +377,24 @@ TEST(ObbNeighbors, MixturesOfShapesAndSizesKeepListsExactAndRunAsCellLists) {
   const double shell = 0.2;
   using NnlSim = Simulation<RigidMixture, ObbNeighbors<AnyShape>>;
   NnlSim nnl(g.box, g.state, m, ObbNeighbors<AnyShape>(m.shape, m.max_scale, shell));
-  Simulation<RigidMixture, CellNeighbors> cells(g.box, g.state, m, CellNeighbors(m.interaction_range()));
   const std::size_t n = g.state.size();
   for (std::uint32_t i = 0; i < n; ++i) {  // the box of each body is its own
     const AnyShape body = m.body_shape(nnl.state(), i);
     const Vec3 ext = std::visit([](const auto& x) { return obb_extents(x); }, body);
     EXPECT_LT((nnl.neighbors().box_of(i).half - (ext.array() + shell).matrix()).norm(), 1e-14) << i;
   }
-  expect_same_collisions(cells, nnl, hb::testing::scaled_count(1000, 0.05), "cell lists (mixture)");
+  {
+    // The same collisions as cell lists, both without the axis memo: which pairs each run solves
+    // differs with its lists, so with memos the searches would start from different axes, and
+    // a contact time found to its tolerance from another start differs by up to ~1e-9 where the
+    // approach is slow (measured: one collision in 1000 at 1.04e-9 with memos, the others
+    // within 1e-10; the memo's own twin is AxisMemoGivesTheSameCollisionsAsColdStarts).
+    RigidMixture cold = m;
+    cold.memo.on = false;
+    NnlSim nnl_cold(g.box, g.state, cold, ObbNeighbors<AnyShape>(cold.shape, cold.max_scale, shell));
+    Simulation<RigidMixture, CellNeighbors> cells(g.box, g.state, cold, CellNeighbors(cold.interaction_range()));
+    expect_same_collisions(cells, nnl_cold, hb::testing::scaled_count(1000, 0.05), "cell lists (mixture)");
+  }
   const double e0 = m.kinetic_energy(nnl.state());
   double worst = kInf;
   const int blocks = hb::testing::scaled_count(20, 0.1, 2);
