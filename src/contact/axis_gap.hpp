@@ -443,7 +443,8 @@ bool clear_along_axis(const SA& sa, const Quat& qa, const Vec3& wa, const SB& sb
   if constexpr (AxisGap<SA, SB>::kMayCurve) {
     // Turn rates 0 (spheres: rotation levers 0): the first-order line is as good; no second order.
     if (!second_order || !(turn_a + turn_b > 0.0) || !AxisGap<SA, SB>::curved(sa, sb)) return false;
-    const double t1 = g > margin && Ku > 0.0 ? (g - margin) / Ku : 0.0;  // first order holds up to here
+    // the first-order line stays above the margin up to t1
+    const double t1 = g > margin && Ku > 0.0 ? (g - margin) / Ku : 0.0;
     const Vec3 pa = qa * sa.support_point(ma), pb = qb * sb.support_point(mb);
     const double ra = wa.cross(pa).dot(u), rb = -wb.cross(pb).dot(u);
     auto curvature = [](const auto& shape, const Vec3& w, SpinBound spin, double sw) {

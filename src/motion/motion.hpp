@@ -31,8 +31,9 @@
 namespace hb {
 
 // A bound of |dW/dt| (W the body-frame angular velocity) for a free top of principal moments
-// `top` whose angular speed stays below wmax. From Euler's equations I_i W_i' = (I_j - I_k) W_j W_k:
-// with c the largest |I_j - I_k| / I_i, |W'|^2 <= c^2 sum_{j<k} W_j^2 W_k^2 <= c^2 |W|^4 / 3.
+// `top` whose angular speed stays below wmax. From Euler's equations
+// I_i W_i' = (I_j - I_k) W_j W_k: with c the largest |I_j - I_k| / I_i,
+// |W'|^2 <= c^2 sum_{j<k} W_j^2 W_k^2 <= c^2 |W|^4 / 3.
 inline double angular_acceleration_bound(const Vec3& top, double wmax) {
   const Vec3& I = top;
   const double c = std::max({std::abs(I[1] - I[2]) / I[0], std::abs(I[2] - I[0]) / I[1],

@@ -186,15 +186,15 @@ struct NeverClear {
 // spherical top (w constant: the tests use w itself), else the largest angular speed of its
 // free rotation (the one the State caches and the solver evaluates) and the bound of |dW/dt|
 // the solver's Motion takes from it.
+inline SpinBound spin_bound(const FreeRotation& rot, const Vec3& top) {
+  const double w = rot.max_angular_speed();
+  return {w, angular_acceleration_bound(top, w)};
+}
 inline SpinBound spin_bound(const BodyState& a) {
-  if (!a.rot) return {};
-  const double w = a.rot->max_angular_speed();
-  return {w, angular_acceleration_bound(a.top, w)};
+  return a.rot ? spin_bound(*a.rot, a.top) : SpinBound{};
 }
 inline SpinBound spin_bound(const State& s, std::uint32_t j) {
-  if (spherical_top(s.top(j))) return {};
-  const double w = s.free_rotation(j).max_angular_speed();
-  return {w, angular_acceleration_bound(s.top(j), w)};
+  return spherical_top(s.top(j)) ? SpinBound{} : spin_bound(s.free_rotation(j), s.top(j));
 }
 
 // The second pre-filter of the rigid models (predict_contacts' `clear`): body i (shape A, state
@@ -356,9 +356,9 @@ struct RigidBodies {
   // Use the loop's per-pair horizons and stop at the earliest contact found (false: every
   // candidate is solved without any horizon; the slow twin the tests compare against).
   bool trim_horizons = true;
-  // Rule out candidates by the gap along one axis (the memo's, or the line of centres) before streaming their
-  // orientation (centre_line_clear; false: every candidate that passes the bounding spheres
-  // goes to the solver, the slow twin of the tests).
+  // Rule out candidates by the gap along one axis (the memo's, or the line of centres) before
+  // streaming their orientation (centre_line_clear; false: every candidate that passes the
+  // bounding spheres goes to the solver, the slow twin of the tests).
   bool centre_line_test = true;
   GrowthLaw law{};  // default: no growth
   // Each pair's last separating axis (contact/axis_memo.hpp; memo.on = false: the slow twin).

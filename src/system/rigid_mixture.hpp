@@ -134,9 +134,9 @@ struct RigidMixture {
   // The second pre-filter of predict_contacts, RigidBodies::centre_line_clear for unlike pairs
   // and any tops: body i (shape sa, state a at `now`) and candidate j cannot touch before
   // `horizon` by the gap along the pair's last separating axis (the memo), or else along their
-  // line of centres (clear_along_memo_or_centres, contact/axis_gap.hpp), computed with the shapes the
-  // solver gets. A resized superquadric is skipped (its construction searches its farthest
-  // point; the solver builds it anyway if needed).
+  // line of centres (clear_along_memo_or_centres, contact/axis_gap.hpp), computed with the
+  // shapes the solver gets. A resized superquadric is skipped (its construction searches its
+  // farthest point; the solver builds it anyway if needed).
   bool centre_line_clear(const State& s, std::uint32_t i, const AnyShape& sa, const BodyState& a,
                          std::uint32_t j, const Vec3& c, double now, double horizon) const {
     if (!centre_line_test) return false;

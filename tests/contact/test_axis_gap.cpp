@@ -215,12 +215,15 @@ void check_second_order_clear(std::uint64_t seed, bool tops) {
     const auto& [p, ma, mb, age, span, c, wa, qa] = cc;
     Vec3 u = c.normalized();
     if (k % 2) u = (Eigen::AngleAxisd(r.uni(0.0, 0.3), r.unit()) * u).normalized();
-    const SpinBound spin_a = tops ? SpinBound{ma.max_angular_speed(), ma.max_angular_acceleration()} : SpinBound{};
-    const SpinBound spin_b = tops ? SpinBound{mb.max_angular_speed(), mb.max_angular_acceleration()} : SpinBound{};
+    auto spin = [tops](const Motion& m) {
+      return tops ? SpinBound{m.max_angular_speed(), m.max_angular_acceleration()} : SpinBound{};
+    };
     const Vec3 dv = p.sb.v - p.sa.v;
-    const bool lin = clear_along_axis(p.a, qa, wa, p.b, p.sb.q, p.sb.w, c, u, dv, age, span, spin_a, spin_b);
-    const bool quad =
-        clear_along_axis(p.a, qa, wa, p.b, p.sb.q, p.sb.w, c, u, dv, age, span, spin_a, spin_b, true);
+    auto clear = [&](bool second_order) {
+      return clear_along_axis(p.a, qa, wa, p.b, p.sb.q, p.sb.w, c, u, dv, age, span, spin(ma),
+                              spin(mb), second_order);
+    };
+    const bool lin = clear(false), quad = clear(true);
     if (lin) {
       EXPECT_TRUE(quad) << k;
     }
@@ -228,7 +231,8 @@ void check_second_order_clear(std::uint64_t seed, bool tops) {
     // Q from central differences of the support functions and the header's M
     auto ha = [&](double t) { return p.a.support(ma.orientation(t).conjugate() * u); };
     auto hb = [&](double t) { return p.b.support(mb.orientation(t).conjugate() * Vec3(-u)); };
-    const double d = 1e-6, ra = (ha(age + d) - ha(age - d)) / (2 * d), rb = (hb(d) - hb(-d)) / (2 * d);
+    const double d = 1e-6;
+    const double ra = (ha(age + d) - ha(age - d)) / (2 * d), rb = (hb(d) - hb(-d)) / (2 * d);
     auto M = [&](const Ellipsoid& e, const Vec3& w, const Motion& m) {
       const double sw = tops ? m.max_angular_speed() : w.cross(u).norm();
       const double mdd = tops ? sw * sw + m.max_angular_acceleration() : w.norm() * sw;

@@ -391,9 +391,12 @@ TEST(ObbNeighbors, MixturesOfShapesAndSizesKeepListsExactAndRunAsCellLists) {
     // within 1e-10; the memo's own twin is AxisMemoGivesTheSameCollisionsAsColdStarts).
     RigidMixture cold = m;
     cold.memo.on = false;
-    NnlSim nnl_cold(g.box, g.state, cold, ObbNeighbors<AnyShape>(cold.shape, cold.max_scale, shell));
-    Simulation<RigidMixture, CellNeighbors> cells(g.box, g.state, cold, CellNeighbors(cold.interaction_range()));
-    expect_same_collisions(cells, nnl_cold, hb::testing::scaled_count(1000, 0.05), "cell lists (mixture)");
+    NnlSim nnl_cold(g.box, g.state, cold,
+                    ObbNeighbors<AnyShape>(cold.shape, cold.max_scale, shell));
+    Simulation<RigidMixture, CellNeighbors> cells(g.box, g.state, cold,
+                                                  CellNeighbors(cold.interaction_range()));
+    expect_same_collisions(cells, nnl_cold, hb::testing::scaled_count(1000, 0.05),
+                           "cell lists (mixture)");
   }
   const double e0 = m.kinetic_energy(nnl.state());
   double worst = kInf;
