@@ -151,7 +151,8 @@ struct Tally {
   double cpu = 0, wall = 0, collisions = 0, neighbour_events = 0, stale = 0;
   double predictions = 0, distance_evals = 0, distance_nr = 0, axis_steps = 0, axis_bounds = 0, hits = 0,
          hit_distance_evals = 0, grazing = 0, contact_fallbacks = 0, distance_fallbacks = 0,
-         collision_distance_fallbacks = 0, prefiltered = 0, centre_line_clears = 0, collision_touches = 0;
+         collision_distance_fallbacks = 0, prefiltered = 0, centre_line_clears = 0, collision_touches = 0,
+         ordered_skips = 0;
   Tally operator-(const Tally& o) const {
     Tally d;
     d.cpu = cpu - o.cpu, d.wall = wall - o.wall, d.collisions = collisions - o.collisions;
@@ -166,6 +167,7 @@ struct Tally {
     d.prefiltered = prefiltered - o.prefiltered;
     d.centre_line_clears = centre_line_clears - o.centre_line_clears;
     d.collision_touches = collision_touches - o.collision_touches;
+    d.ordered_skips = ordered_skips - o.ordered_skips;
     return d;
   }
   Tally& operator+=(const Tally& o) {
@@ -176,7 +178,7 @@ struct Tally {
     contact_fallbacks += o.contact_fallbacks, distance_fallbacks += o.distance_fallbacks;
     collision_distance_fallbacks += o.collision_distance_fallbacks;
     prefiltered += o.prefiltered, centre_line_clears += o.centre_line_clears;
-    collision_touches += o.collision_touches;
+    collision_touches += o.collision_touches, ordered_skips += o.ordered_skips;
     return *this;
   }
   double fallbacks() const { return contact_fallbacks + distance_fallbacks + collision_distance_fallbacks; }
@@ -205,7 +207,7 @@ Tally tally(const Sim& sim) {
     t.distance_fallbacks = double(s.distance_fallbacks);
     t.collision_distance_fallbacks = double(s.collision_distance_fallbacks);
     t.prefiltered = double(s.prefiltered), t.centre_line_clears = double(s.centre_line_clears);
-    t.collision_touches = double(s.collision_touches);
+    t.collision_touches = double(s.collision_touches), t.ordered_skips = double(s.ordered_skips);
   }
   return t;
 }
@@ -245,10 +247,12 @@ inline void put_costs(Json& j, const Tally& d) {
   j["tau_c_us"] = 1e6 * d.cpu / nc;
   j["collisions_per_second"] = d.collisions / std::max(d.cpu, 1e-12);
   j["predictions_per_collision"] = d.predictions / nc;
-  // of those, answered without a solver: by the bounding spheres or the line of centres
-  // (system/rigid_bodies.hpp predict_contacts), and by the line of centres alone
+  // of those, answered without a solver: by the bounding spheres, the gap along one axis or the
+  // ordered loop (system/rigid_bodies.hpp predict_contacts), by the gap along one axis alone,
+  // and by the ordered loop alone
   j["prefiltered_per_collision"] = d.prefiltered / nc;
   j["centre_line_clears_per_collision"] = d.centre_line_clears / nc;
+  j["ordered_skips_per_collision"] = d.ordered_skips / nc;
   j["collision_touches_per_collision"] = d.collision_touches / nc;
   j["distance_evals_per_prediction"] = d.distance_evals / np;
   j["distance_evals_per_collision"] = d.distance_evals / nc;

@@ -423,12 +423,18 @@ struct SpinBound {
   double wmax = -1.0;  // < 0: a spherical top (w constant); else the largest angular speed
   double dwmax = 0.0;  // a bound of |dW/dt| (not spherical tops)
 };
+// axis_clear_time: how long the gap along u is proven positive, a duration tau_c >= 0 from `now`
+// (kInf: for ever): g_u > margin on [now, now + tau_c) by the first-order line or, beyond its
+// end t1, by Q. The line stays above the margin up to t1 = (g1 - margin) / K_u; Q is concave,
+// so where Q(t1) > margin it stays above the margin up to its larger root r2 of Q = margin
+// (and tau_c = r2), else tau_c = t1. A first-order t1 beyond `span` (the caller's window) is
+// returned as it is: the second order is not needed. clear_along_axis is tau_c > span. The
+// prediction loop (system/rigid_bodies.hpp, predict_contacts) orders its candidates by tau_c.
 template <SupportShape SA, SupportShape SB>
-bool clear_along_axis(const SA& sa, const Quat& qa, const Vec3& wa, const SB& sb, const Quat& qb,
-                      const Vec3& wb, const Vec3& c, const Vec3& u, const Vec3& dv, double age,
-                      double span, SpinBound spin_a = {}, SpinBound spin_b = {},
-                      bool second_order = false) {
-  if (!(span < kInf)) return false;
+double axis_clear_time(const SA& sa, const Quat& qa, const Vec3& wa, const SB& sb, const Quat& qb,
+                       const Vec3& wb, const Vec3& c, const Vec3& u, const Vec3& dv, double age,
+                       double span, SpinBound spin_a = {}, SpinBound spin_b = {},
+                       bool second_order = false) {
   auto turn_speed = [&u](const Vec3& w, SpinBound spin) {  // a bound of |m'|
     return spin.wmax < 0.0 ? w.cross(u).norm() : spin.wmax;
   };
@@ -439,12 +445,12 @@ bool clear_along_axis(const SA& sa, const Quat& qa, const Vec3& wa, const SB& sb
   const double g = g_old - turn_b * age;
   const double Ku = std::abs(u.dot(dv)) + turn_a + turn_b;
   const double margin = 1e-10 * (sa.bounding_radius() + sb.bounding_radius());
-  if (g - Ku * span > margin) return true;
+  // the first-order line stays above the margin up to t1
+  const double t1 = !(g > margin) ? 0.0 : Ku > 0.0 ? (g - margin) / Ku : kInf;
+  if (t1 > span) return t1;  // the window is covered: no second order needed
   if constexpr (AxisGap<SA, SB>::kMayCurve) {
     // Turn rates 0 (spheres: rotation levers 0): the first-order line is as good; no second order.
-    if (!second_order || !(turn_a + turn_b > 0.0) || !AxisGap<SA, SB>::curved(sa, sb)) return false;
-    // the first-order line stays above the margin up to t1
-    const double t1 = g > margin && Ku > 0.0 ? (g - margin) / Ku : 0.0;
+    if (!second_order || !(turn_a + turn_b > 0.0) || !AxisGap<SA, SB>::curved(sa, sb)) return t1;
     const Vec3 pa = qa * sa.support_point(ma), pb = qb * sb.support_point(mb);
     const double ra = wa.cross(pa).dot(u), rb = -wb.cross(pb).dot(u);
     auto curvature = [](const auto& shape, const Vec3& w, SpinBound spin, double sw) {
@@ -452,23 +458,44 @@ bool clear_along_axis(const SA& sa, const Quat& qa, const Vec3& wa, const SB& sb
       return shape.max_curvature_radius() * sw * sw + shape.bounding_radius() * mdd;
     };
     const double Ma = curvature(sa, wa, spin_a, sw_a), Mb = curvature(sb, wb, spin_b, sw_b);
-    const double q0 = g_old - age * (rb + 0.5 * Mb * age);
+    const double q0 = g_old - age * (rb + 0.5 * Mb * age) - margin;  // Q - margin
     const double q1 = u.dot(dv) - ra - rb - Mb * age;
     const double q2 = 0.5 * (Ma + Mb);
-    auto Q = [&](double tau) { return q0 + tau * (q1 - q2 * tau); };
-    return Q(t1) > margin && Q(span) > margin;
+    if (!(q0 + t1 * (q1 - q2 * t1) > 0.0)) return t1;  // Q(t1) <= margin: the line's t1
+    // Q - margin > 0 at t1: its larger root, written without cancellation
+    if (!(q2 > 0.0)) return q1 < 0.0 ? std::max(t1, q0 / -q1) : kInf;
+    const double s = std::sqrt(q1 * q1 + 4.0 * q2 * q0);
+    return std::max(t1, q1 >= 0.0 ? (q1 + s) / (2.0 * q2) : 2.0 * q0 / (s - q1));
   }
-  return false;
+  return t1;
+}
+template <SupportShape SA, SupportShape SB>
+bool clear_along_axis(const SA& sa, const Quat& qa, const Vec3& wa, const SB& sb, const Quat& qb,
+                      const Vec3& wb, const Vec3& c, const Vec3& u, const Vec3& dv, double age,
+                      double span, SpinBound spin_a = {}, SpinBound spin_b = {},
+                      bool second_order = false) {
+  return span < kInf &&
+         axis_clear_time(sa, qa, wa, sb, qb, wb, c, u, dv, age, span, spin_a, spin_b, second_order) >
+             span;
+}
+template <SupportShape SA, SupportShape SB>
+double centres_clear_time(const SA& sa, const Quat& qa, const Vec3& wa, const SB& sb,
+                          const Quat& qb, const Vec3& wb, const Vec3& c, const Vec3& dv,
+                          double age, double span, SpinBound spin_a = {},
+                          SpinBound spin_b = {}, bool second_order = false) {
+  const double cn = c.norm();
+  if (!(cn > 0.0)) return 0.0;
+  return axis_clear_time(sa, qa, wa, sb, qb, wb, c, Vec3(c / cn), dv, age, span, spin_a, spin_b,
+                         second_order);
 }
 template <SupportShape SA, SupportShape SB>
 bool clear_along_centres(const SA& sa, const Quat& qa, const Vec3& wa, const SB& sb,
                          const Quat& qb, const Vec3& wb, const Vec3& c, const Vec3& dv,
                          double age, double span, SpinBound spin_a = {}, SpinBound spin_b = {},
                          bool second_order = false) {
-  const double cn = c.norm();
-  if (!(cn > 0.0)) return false;
-  return clear_along_axis(sa, qa, wa, sb, qb, wb, c, Vec3(c / cn), dv, age, span, spin_a, spin_b,
-                          second_order);
+  return span < kInf &&
+         centres_clear_time(sa, qa, wa, sb, qb, wb, c, dv, age, span, spin_a, spin_b,
+                            second_order) > span;
 }
 
 template <SupportShape SA, SupportShape SB>

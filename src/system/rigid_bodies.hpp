@@ -10,10 +10,12 @@
 #pragma once
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <sstream>
 #include <stdexcept>
 #include <type_traits>
+#include <vector>
 
 #include "collision/rigid.hpp"
 #include "contact/axis_memo.hpp"
@@ -44,6 +46,8 @@ struct SolverStats {
   std::uint64_t prefiltered = 0;  // predictions answered by predict_contacts' pre-filters, no solver
   std::uint64_t centre_line_clears = 0;  // those of them answered by the line of centres
   std::uint64_t collision_touches = 0;   // collisions whose contact was read off the memo axis
+  std::uint64_t ordered_skips = 0;  // predictions answered by predict_contacts' order: no contact
+                                    // before the earliest found, no solver (in `prefiltered`)
 
   void add(const ContactResult& r) {
     ++predictions;
@@ -177,9 +181,9 @@ DistanceResult collision_distance(const SA& sa, const Quat& qa, const Pose& pa, 
   return distance(sa, pa, sb, pb, o);
 }
 
-// The no-op second pre-filter of predict_contacts (below).
+// The no-op second pre-filter of predict_contacts (below): nothing proven clear.
 struct NeverClear {
-  bool operator()(const BodyState&, std::uint32_t, const Vec3&, double) const { return false; }
+  double operator()(const BodyState&, std::uint32_t, const Vec3&, double) const { return 0.0; }
 };
 
 // A body's rotation for the pre-filters (SpinBound of contact/axis_gap.hpp): wmax = -1 for a
@@ -197,12 +201,12 @@ inline SpinBound spin_bound(const State& s, std::uint32_t j) {
   return spherical_top(s.top(j)) ? SpinBound{} : spin_bound(s.free_rotation(j), s.top(j));
 }
 
-// The second pre-filter of the rigid models (predict_contacts' `clear`): body i (shape A, state
-// a at `now`) and candidate j (shape B, centre separation c at `now`, orientation at its own
-// time) cannot touch before `horizon` by the gap along one fixed axis (clear_along_axis, to
-// first and second order; any fixed axis gives a valid bound): the pair's last separating axis
-// in the memo, either side's slot (AxisMemo::find_either, as the solver's axis_start), or, for
-// a pair not in the memo, their line of centres (clear_along_centres).
+// The second pre-filter of the rigid models (predict_contacts' `clear`): how long body i (shape
+// A, state a at `now`) and candidate j (shape B, centre separation c at `now`, orientation at its
+// own time) are proven not to touch, a duration from `now`, by the gap along one fixed axis
+// (axis_clear_time, to first and second order; any fixed axis gives a valid bound): the pair's
+// last separating axis in the memo, either side's slot (AxisMemo::find_either, as the solver's
+// axis_start), or, for a pair not in the memo, their line of centres (centres_clear_time).
 // Measured (callgrind, docs/benchmarks/README.md, "Session of 2026-11-29, eighth part"):
 // - the second order along the memo's axis clears half the candidates the first order leaves
 //   to the solver at X0 = 10, phi = 0.4 (-9.4 % instructions there, -4.6 % at X0 = 2, phi = 0.5);
@@ -211,18 +215,18 @@ inline SpinBound spin_bound(const State& s, std::uint32_t j) {
 //   it came second since the sixth part) clears too few to pay for itself: -2.7 % at X0 = 2
 //   without it, no change at X0 = 10.
 template <class SA, class SB>
-bool clear_along_memo_or_centres(const SA& A, const SB& B, const State& s, std::uint32_t i,
-                                 const BodyState& a, std::uint32_t j, const Vec3& c, double now,
-                                 double horizon, const AxisMemo& memo) {
+double memo_or_centres_clear_time(const SA& A, const SB& B, const State& s, std::uint32_t i,
+                                  const BodyState& a, std::uint32_t j, const Vec3& c, double now,
+                                  double horizon, const AxisMemo& memo) {
   const Vec3 dv = s.v[j] - a.v;
   const SpinBound wa = spin_bound(a), wb = spin_bound(s, j);
   const double age = now - s.t[j], span = horizon - now;
   Vec3 u;
   if (memo.find_either(i, j, u))
-    return clear_along_axis(A, a.q, a.w, B, s.q[j], s.w[j], c, Vec3(u.normalized()), dv, age,
-                            span, wa, wb, /*second_order=*/true);
-  return clear_along_centres(A, a.q, a.w, B, s.q[j], s.w[j], c, dv, age, span, wa, wb,
-                             /*second_order=*/true);
+    return axis_clear_time(A, a.q, a.w, B, s.q[j], s.w[j], c, Vec3(u.normalized()), dv, age, span,
+                           wa, wb, /*second_order=*/true);
+  return centres_clear_time(A, a.q, a.w, B, s.q[j], s.w[j], c, dv, age, span, wa, wb,
+                            /*second_order=*/true);
 }
 
 // The prediction loop of the rigid pair models (RigidBodies, RigidMixture): body i (at `now`)
@@ -238,16 +242,36 @@ bool clear_along_memo_or_centres(const SA& A, const SB& B, const State& s, std::
 // set up: the same test on the same numbers (or on a radius no smaller), so the same result
 // (counted as the prediction it replaces, and in stats.prefiltered). With a number (the
 // solver's own radius) the window it found, {lo, hi}, is handed to solve as `window`, for
-// ContactInput::window_given (the solver does not repeat the test); else window is null. A
-// candidate that passes it is offered to
-// clear(a, j, c, horizon) (c = r_j - r_i at `now`): true means no contact in the window, proven
-// without streaming j's orientation (the gap along the line of centres, clear_along_centres of
-// contact/axis_gap.hpp), so the solver, which would answer none, is not set up.
+// ContactInput::window_given (the solver does not repeat the test); else window is null (but
+// see `order` below). A candidate that passes it is offered to clear(a, j, c, horizon) (c = r_j - r_i at `now`),
+// which returns how long after `now` the pair is proven not to touch (a double, 0: nothing
+// proven), without streaming j's orientation (the gap along one axis,
+// memo_or_centres_clear_time above); if that covers the window, the solver, which would answer
+// none, is not set up.
+//
+// `order` (with `trim`): the candidates left after both pre-filters are solved in the order of
+// their lower bounds of the contact time, t_lb = max(the bounding spheres' entry, now + the
+// clear time), and the loop stops at the first whose t_lb is not before the earliest contact
+// found: none of the rest can touch before it, and a contact after it is not needed (the
+// windows are cut there anyway). Each solve's window ends at the earliest contact found before
+// it, so the contacts found early shorten the later windows, and starts at the candidate's t_lb:
+// solve gets window = {t_lb, its end} (with the solver's own radius, the bounding spheres'
+// window cut to [t_lb, horizon]: ContactInput::window_given; with another radius, the search
+// starts at t_lb, ContactInput::t_start, and the solver runs its own test from there). Measured
+// at X0 = 10, phi = 0.4 (callgrind, docs/benchmarks/README.md, "Session of 2026-11-30"): solves
+// per collision 8.6 -> 7.2, instructions -12 %. The earliest contact is the one
+// the candidates' own order finds (a contact time to the solver's tolerance: the windows, and
+// so the solves' last steps, differ); false: the candidates' order (the twin of the tests).
 template <class Solve, class Fail, class Radius = double, class Clear = NeverClear>
 void predict_contacts(const State& s, const Box& box, std::uint32_t i, const std::uint32_t* js,
                       const Vec3* shifts, std::size_t n, double now, const double* horizons,
                       double* out, double law_end, bool trim, SolverStats& stats, Solve&& solve,
-                      Fail&& fail, const Radius& window_radius = Radius{}, Clear&& clear = Clear{}) {
+                      Fail&& fail, const Radius& window_radius = Radius{}, Clear&& clear = Clear{},
+                      bool order = false) {
+  static_assert(std::is_same_v<std::invoke_result_t<Clear&, const BodyState&, std::uint32_t,
+                                                    const Vec3&, double>,
+                               double>,
+                "clear returns the duration proven clear (a double), not a bool");
   auto radius = [&window_radius](std::uint32_t j) {
     if constexpr (std::is_arithmetic_v<Radius>) {
       (void)j;
@@ -256,9 +280,34 @@ void predict_contacts(const State& s, const Box& box, std::uint32_t i, const std
       return double(window_radius(j));
     }
   };
+  // A candidate for the solver: its index, position (image), window and lower bound.
+  struct Pending {
+    double t_lb;
+    std::uint32_t k;
+    bool window;  // lo, hi are the solver's own bounding-sphere window
+    double lo, hi;
+    Vec3 rb;
+  };
+  thread_local std::vector<Pending> pending;  // the ordered mode's candidates (scratch)
+  order = order && trim;
+  pending.clear();
   if (n > 0) s.prefetch(js[0]);
   const BodyState a = s.body(i);  // body i is at `now`
   double earliest = kInf;
+  auto run = [&](const Pending& p, double horizon) {
+    const std::uint32_t j = js[p.k];
+    // ordered: the search starts at the lower bound (no contact before it)
+    const double lohi[2] = {order ? p.t_lb : p.lo, std::min(p.hi, horizon)};
+    BodyState b = s.body_at(j, now);
+    b.r = p.rb;
+    const ContactResult r = solve(a, b, j, horizon, order || p.window ? lohi : nullptr);
+    stats.add(r);
+    if (r.status == ContactStatus::failed) throw SolverFailure(fail(a, b, j, horizon));
+    if (r.status == ContactStatus::hit) {
+      out[p.k] = std::max(0.0, r.time - now);
+      earliest = std::min(earliest, r.time);
+    }
+  };
   for (std::size_t k = 0; k < n; ++k) {
     const std::uint32_t j = js[k];
     out[k] = kInf;
@@ -266,34 +315,40 @@ void predict_contacts(const State& s, const Box& box, std::uint32_t i, const std
     const double horizon = trim ? std::min({horizons ? horizons[k] : kInf, law_end, earliest}) : law_end;
     if (j == i || !(horizon > now)) continue;
     const Vec3 rj = s.r[j] + s.v[j] * (now - s.t[j]);  // as State::body_at streams it
-    const Vec3 rb = shifts ? Vec3(rj + shifts[k]) : Vec3(a.r + box.near_image(rj - a.r));
-    const double* window = nullptr;  // the bounding spheres' window, when it is the solver's
-    double lohi[2] = {now, horizon};
+    Pending p{now, static_cast<std::uint32_t>(k), false, now, horizon,
+              shifts ? Vec3(rj + shifts[k]) : Vec3(a.r + box.near_image(rj - a.r))};
     if (const double R = radius(j); R > 0.0) {
       BodyState b0;
-      b0.r = rb, b0.v = s.v[j];
-      double &lo = lohi[0], &hi = lohi[1];
-      if (!bounding_sphere_window(a, b0, now, R, lo, hi) || !(lo <= hi)) {
+      b0.r = p.rb, b0.v = s.v[j];
+      if (!bounding_sphere_window(a, b0, now, R, p.lo, p.hi) || !(p.lo <= p.hi)) {
         stats.add_none();  // the solver's answer to this test: none
         ++stats.prefiltered;
         continue;
       }
-      if (clear(a, j, Vec3(rb - a.r), horizon)) {
+      const double tau = clear(a, j, Vec3(p.rb - a.r), horizon);
+      if (tau > horizon - now) {
         stats.add_none();  // no contact in the window: the solver's answer
         ++stats.prefiltered, ++stats.centre_line_clears;
         continue;
       }
-      if constexpr (std::is_arithmetic_v<Radius>) window = lohi;  // the solver's own radius
+      p.t_lb = std::max(p.lo, now + tau);
+      p.window = std::is_arithmetic_v<Radius>;  // the solver's own radius
     }
-    BodyState b = s.body_at(j, now);
-    b.r = rb;
-    const ContactResult r = solve(a, b, j, horizon, window);
-    stats.add(r);
-    if (r.status == ContactStatus::failed) throw SolverFailure(fail(a, b, j, horizon));
-    if (r.status == ContactStatus::hit) {
-      out[k] = std::max(0.0, r.time - now);
-      earliest = std::min(earliest, r.time);
+    if (order) pending.push_back(p);
+    else run(p, horizon);
+  }
+  if (!order) return;
+  std::sort(pending.begin(), pending.end(), [](const Pending& x, const Pending& y) {
+    return x.t_lb < y.t_lb || (x.t_lb == y.t_lb && x.k < y.k);
+  });
+  for (const Pending& p : pending) {
+    if (!(p.t_lb < earliest)) {  // this one and the rest: no contact before the earliest
+      stats.add_none();
+      ++stats.prefiltered, ++stats.ordered_skips;
+      continue;
     }
+    const double horizon = std::min({horizons ? horizons[p.k] : kInf, law_end, earliest});
+    run(p, horizon);
   }
 }
 
@@ -360,6 +415,9 @@ struct RigidBodies {
   // streaming their orientation (centre_line_clear; false: every candidate that passes the
   // bounding spheres goes to the solver, the slow twin of the tests).
   bool centre_line_test = true;
+  // Solve the candidates left in the order of their lower bounds of the contact time, up to the
+  // earliest contact found (predict_contacts' `order`; false: the candidates' order, the twin).
+  bool order_by_bound = true;
   GrowthLaw law{};  // default: no growth
   // Each pair's last separating axis (contact/axis_memo.hpp; memo.on = false: the slow twin).
   mutable AxisMemo memo{};
@@ -397,18 +455,20 @@ struct RigidBodies {
         sl.active() ? 0.0 : window_radius(),
         [&](const BodyState& a, std::uint32_t j, const Vec3& c, double horizon) {
           return centre_line_clear(s, i, a, j, c, now, horizon);
-        });
+        },
+        order_by_bound);
   }
-  // The pre-filter of predict_contacts after the bounding spheres (no growth): body i (state a
-  // at `now`) and candidate j (centre separation c at `now`, orientation at its own time) cannot
-  // touch before `horizon` by the gap along the pair's last separating axis (the memo), or, for
-  // a pair not in it, along their line of centres (clear_along_memo_or_centres,
-  // contact/axis_gap.hpp; for tops that are not spherical with their largest angular speeds,
-  // from the free rotation the solver uses); false when off (centre_line_test, the slow twin)
-  // or not decided.
-  bool centre_line_clear(const State& s, std::uint32_t i, const BodyState& a, std::uint32_t j,
-                         const Vec3& c, double now, double horizon) const {
-    return centre_line_test && clear_along_memo_or_centres(shape, shape, s, i, a, j, c, now, horizon, memo);
+  // The pre-filter of predict_contacts after the bounding spheres (no growth): how long after
+  // `now` body i (state a at `now`) and candidate j (centre separation c at `now`, orientation at
+  // its own time) are proven not to touch, by the gap along the pair's last separating axis (the
+  // memo), or, for a pair not in it, along their line of centres (memo_or_centres_clear_time; for
+  // tops that are not spherical with their largest angular speeds, from the free rotation the
+  // solver uses); 0 when off (centre_line_test, the slow twin).
+  double centre_line_clear(const State& s, std::uint32_t i, const BodyState& a, std::uint32_t j,
+                           const Vec3& c, double now, double horizon) const {
+    return centre_line_test
+               ? memo_or_centres_clear_time(shape, shape, s, i, a, j, c, now, horizon, memo)
+               : 0.0;
   }
   // The radius of contact_time's bounding-sphere test for two bodies of this shape at scale 1
   // (no growth): L_A + L_B plus its margin.

@@ -57,6 +57,7 @@ struct RigidMixture {
   // Then rule out candidates by the gap along the line of centres (centre_line_clear; false:
   // every candidate that passes the bounding spheres goes to the solver, the slow twin).
   bool centre_line_test = true;
+  bool order_by_bound = true;  // as RigidBodies::order_by_bound
   // Each pair's last separating axis (contact/axis_memo.hpp; memo.on = false: the slow twin).
   mutable AxisMemo memo{};
 
@@ -104,12 +105,15 @@ struct RigidMixture {
     const double law_end = now < law.t_stop ? law.t_stop : kInf;  // the law changes there
     predict_contacts(
         s, box, i, js, shifts, n, now, horizons, out, law_end, trim_horizons, stats,
-        [&](const BodyState& a, const BodyState& b, std::uint32_t j, double horizon, const double*) {
+        [&](const BodyState& a, const BodyState& b, std::uint32_t j, double horizon,
+            const double* window) {
           return std::visit(
               [&](const auto& A, const auto& B) {
                 using SA = std::decay_t<decltype(A)>;
                 using SB = std::decay_t<decltype(B)>;
-                ContactInput<SA, SB> in{A, B, a, b, now, now, horizon, eps_d};
+                // the ordered loop's lower bound of the contact time: the search starts there
+                // (the solver runs its own bounding-sphere test; window_radius may be wider)
+                ContactInput<SA, SB> in{A, B, a, b, now, window ? window[0] : now, horizon, eps_d};
                 in.growth = sl;
                 memo.find_either(i, j, in.axis_start);
                 const ContactResult r = contact_time(in, options);
@@ -129,41 +133,47 @@ struct RigidMixture {
         },
         [&](const BodyState& a, std::uint32_t j, const Vec3& c, double horizon) {
           return centre_line_clear(s, i, sa, a, j, c, now, horizon);
-        });
+        },
+        order_by_bound);
   }
   // The second pre-filter of predict_contacts, RigidBodies::centre_line_clear for unlike pairs
-  // and any tops: body i (shape sa, state a at `now`) and candidate j cannot touch before
-  // `horizon` by the gap along the pair's last separating axis (the memo), or else along their
-  // line of centres (clear_along_memo_or_centres, contact/axis_gap.hpp), computed with the
-  // shapes the solver gets. A resized superquadric is skipped (its construction searches its
-  // farthest point; the solver builds it anyway if needed).
-  bool centre_line_clear(const State& s, std::uint32_t i, const AnyShape& sa, const BodyState& a,
-                         std::uint32_t j, const Vec3& c, double now, double horizon) const {
-    if (!centre_line_test) return false;
+  // and any tops: how long after `now` body i (shape sa, state a at `now`) and candidate j are
+  // proven not to touch, by the gap along the pair's last separating axis (the memo), or else
+  // along their line of centres (memo_or_centres_clear_time, system/rigid_bodies.hpp), computed
+  // with the shapes the solver gets. A resized superquadric is skipped (0: its construction
+  // searches its farthest point; the solver builds it anyway if needed).
+  double centre_line_clear(const State& s, std::uint32_t i, const AnyShape& sa, const BodyState& a,
+                           std::uint32_t j, const Vec3& c, double now, double horizon) const {
+    if (!centre_line_test) return 0.0;
     const AnyShape& base = shape[s.species[j]];
     AnyShape scaled;
     const AnyShape* sb = &base;
     if (s.scale[j] != 1.0) {
-      if (std::holds_alternative<Superquadric>(base)) return false;
+      if (std::holds_alternative<Superquadric>(base)) return 0.0;
       scaled = resized(base, s.scale[j]);
       sb = &scaled;
     }
     return std::visit(
         [&](const auto& A, const auto& B) {
-          return clear_along_memo_or_centres(A, B, s, i, a, j, c, now, horizon, memo);
+          return memo_or_centres_clear_time(A, B, s, i, a, j, c, now, horizon, memo);
         },
         sa, *sb);
   }
   // The radius of predict_contacts' bounding-sphere test for body i (bounding radius Li) and
   // candidate j: no smaller than the solver's own (contact_time.hpp: L_i + L_j plus its margin,
   // from the resized shapes), so a pair it rejects is one the solver's first test rejects too.
-  // L_j is taken as the species' radius times scale_j, which is exact for spheres and
-  // ellipsoids; a superquadric's resized radius is found anew by a numerical search (its
-  // farthest point), so L_j carries a relative slack of 1e-6, far above that search's error and
-  // far below anything that would let a pair through that the bounding spheres rule out.
+  // L_j is taken as the species' radius times scale_j, which is exact for spheres, ellipsoids
+  // and any shape at scale 1; a superquadric's resized radius is found anew by a numerical
+  // search (its farthest point), so there L_j carries a relative slack of 1e-6, far above that
+  // search's error and far below anything that would let a pair through that the bounding
+  // spheres rule out.
   double window_radius(double Li, const State& s, std::uint32_t j) const {
-    const double Lj = bounding_radius(shape[s.species[j]]) * s.scale[j];
-    const double slack = 1.0 + 1e-6;
+    const AnyShape& sj = shape[s.species[j]];
+    const double Lj = bounding_radius(sj) * s.scale[j];
+    // the solver's own radius where L_j is exact (so one species of spheres or ellipsoids runs
+    // the single-shape model's trajectory, whose windows and order come from these numbers)
+    const bool searched = s.scale[j] != 1.0 && std::holds_alternative<Superquadric>(sj);
+    const double slack = searched ? 1.0 + 1e-6 : 1.0;
     return (Li + Lj) * slack + bounding_window_margin(std::max(Li, Lj) * slack, eps_d);
   }
 

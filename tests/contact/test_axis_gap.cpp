@@ -204,11 +204,13 @@ TEST(AxisGap, ClearAlongCentresIsBelowTheGapAlongThemForAsymmetricTops) {
 // tau) over the window (the Taylor bound and M hold), and wherever the test says clear, g_u
 // and the distance stay positive. Axes: the line of centres, or one tilted from it by up to 0.3
 // rad (as a remembered axis is); ellipsoids of aspect up to 5, spherical or asymmetric tops.
-// The second order must clear every pair the first order clears, and more.
+// The second order must clear every pair the first order clears, and more. The clear time of
+// the same bound (axis_clear_time, by which the prediction loop orders its candidates) agrees
+// with the test, and g_u and the distance stay positive before it.
 void check_second_order_clear(std::uint64_t seed, bool tops) {
   Rng r(seed);
   const int n = scaled_count(2000, 0.1);
-  int first = 0, second = 0;
+  int first = 0, second = 0, clear_times = 0;
   double worst = -kInf;
   for (int k = 0; k < n; ++k) {
     const ClearCase cc = clear_case(r, tops);
@@ -228,6 +230,23 @@ void check_second_order_clear(std::uint64_t seed, bool tops) {
       EXPECT_TRUE(quad) << k;
     }
     first += lin, second += quad;
+    // the clear time itself (the prediction loop's order, span kInf: the whole bound): g_u and
+    // the distance positive before it, sampled up to 1.5 spans beyond the window
+    const double tc = axis_clear_time(p.a, qa, wa, p.b, p.sb.q, p.sb.w, c, u, dv, age, kInf,
+                                      spin(ma), spin(mb), true);
+    EXPECT_EQ(quad, tc > span) << k;
+    clear_times += tc > 0.0;
+    for (int m = 0; m < 20 && tc > 0.0; ++m) {
+      const double t = age + std::min(tc, 2.5 * span) * m / 20.0;
+      const Vec3 ct = mb.position(t) - ma.position(t);
+      EXPECT_GT(u.dot(ct) - p.a.support(ma.orientation(t).conjugate() * u) -
+                    p.b.support(mb.orientation(t).conjugate() * Vec3(-u)),
+                0.0)
+          << k << " " << t;
+      if (m % 5 == 0) {
+        EXPECT_GT(reference_distance_at(p, t), 0.0) << k << " " << t;
+      }
+    }
     // Q from central differences of the support functions and the header's M
     auto ha = [&](double t) { return p.a.support(ma.orientation(t).conjugate() * u); };
     auto hb = [&](double t) { return p.b.support(mb.orientation(t).conjugate() * Vec3(-u)); };
@@ -254,8 +273,10 @@ void check_second_order_clear(std::uint64_t seed, bool tops) {
       }
     }
   }
-  std::printf("  %d pairs%s: %d clear to first order, %d with the second, max (Q - g_u) %.2e\n", n,
-              tops ? " (asymmetric tops)" : "", first, second, worst);
+  std::printf("  %d pairs%s: %d clear to first order, %d with the second, %d with a clear time "
+              "> 0, max (Q - g_u) %.2e\n", n, tops ? " (asymmetric tops)" : "", first, second,
+              clear_times, worst);
+  EXPECT_GT(clear_times, second);
   EXPECT_LE(worst, 1e-8);  // central differences: rates to ~1e-10
   EXPECT_GT(second, first + n / 50);
   EXPECT_LT(second, n);

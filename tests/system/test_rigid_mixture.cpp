@@ -149,6 +149,10 @@ SolverStats compare_mixture_prefilter(const SpeciesTable& sp, bool centre_line) 
   // own test: test_axis_memo). The bounding spheres rule out only what the solver's first test
   // does, which leaves the memo alone: compared with it.
   m.memo.on = !centre_line;
+  // The candidates in their own order: which are solved, and with what windows, would differ
+  // with the pre-filters' bounds (ordered loop, RigidBodies::order_by_bound; its own twin:
+  // test_obb_neighbors).
+  m.order_by_bound = false;
   RigidMixture plain = m;
   plain.position_prefilter = plain.centre_line_test = false;
   Simulation<RigidMixture, CellNeighbors> a(g.box, g.state, m, CellNeighbors(m.interaction_range()));
@@ -296,6 +300,8 @@ void check_centre_line_test(const Vec3& inertia) {
   // Without the axis memo: what the solver is asked differs with the test, so the memos (and
   // the solvers' paths, in their last bits) would too (the memo's own test: test_axis_memo).
   model.memo.on = false;
+  // The candidates in their own order, as in compare_mixture_prefilter.
+  model.order_by_bound = false;
   RigidBodies<Ellipsoid> plain = model;
   plain.centre_line_test = false;
   const double R = model.window_radius();
