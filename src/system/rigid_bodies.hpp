@@ -243,9 +243,9 @@ double memo_or_centres_clear_time(const SA& A, const SB& B, const State& s, std:
 // (counted as the prediction it replaces, and in stats.prefiltered). With a number (the
 // solver's own radius) the window it found, {lo, hi}, is handed to solve as `window`, for
 // ContactInput::window_given (the solver does not repeat the test); else window is null (but
-// see `order` below). A candidate that passes it is offered to clear(a, j, c, horizon) (c = r_j - r_i at `now`),
-// which returns how long after `now` the pair is proven not to touch (a double, 0: nothing
-// proven), without streaming j's orientation (the gap along one axis,
+// see `order` below). A candidate that passes it is offered to clear(a, j, c, horizon)
+// (c = r_j - r_i at `now`), which returns how long after `now` the pair is proven not to touch
+// (a double, 0: nothing proven), without streaming j's orientation (the gap along one axis,
 // memo_or_centres_clear_time above); if that covers the window, the solver, which would answer
 // none, is not set up.
 //
@@ -256,8 +256,9 @@ double memo_or_centres_clear_time(const SA& A, const SB& B, const State& s, std:
 // windows are cut there anyway). Each solve's window ends at the earliest contact found before
 // it, so the contacts found early shorten the later windows, and starts at the candidate's t_lb:
 // solve gets window = {t_lb, its end} (with the solver's own radius, the bounding spheres'
-// window cut to [t_lb, horizon]: ContactInput::window_given; with another radius, the search
-// starts at t_lb, ContactInput::t_start, and the solver runs its own test from there). Measured
+// window cut to [t_lb, horizon]: ContactInput::window_given; with another radius, when
+// t_lb > now, the search starts at t_lb, ContactInput::t_start, and the solver runs its own
+// test from there). Measured
 // at X0 = 10, phi = 0.4 (callgrind, docs/benchmarks/README.md, "Session of 2026-11-30"): solves
 // per collision 8.6 -> 7.2, instructions -12 %. The earliest contact is the one
 // the candidates' own order finds (a contact time to the solver's tolerance: the windows, and
@@ -296,11 +297,13 @@ void predict_contacts(const State& s, const Box& box, std::uint32_t i, const std
   double earliest = kInf;
   auto run = [&](const Pending& p, double horizon) {
     const std::uint32_t j = js[p.k];
-    // ordered: the search starts at the lower bound (no contact before it)
+    // The window handed to solve: the solver's own bounding-sphere window (p.window), and in
+    // the ordered loop a search that starts at the candidate's bound (no contact before it).
     const double lohi[2] = {order ? p.t_lb : p.lo, std::min(p.hi, horizon)};
+    const bool give = p.window || (order && p.t_lb > now);
     BodyState b = s.body_at(j, now);
     b.r = p.rb;
-    const ContactResult r = solve(a, b, j, horizon, order || p.window ? lohi : nullptr);
+    const ContactResult r = solve(a, b, j, horizon, give ? lohi : nullptr);
     stats.add(r);
     if (r.status == ContactStatus::failed) throw SolverFailure(fail(a, b, j, horizon));
     if (r.status == ContactStatus::hit) {
