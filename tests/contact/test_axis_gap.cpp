@@ -230,6 +230,9 @@ void check_second_order_clear(std::uint64_t seed, bool tops) {
       EXPECT_TRUE(quad) << k;
     }
     first += lin, second += quad;
+    // the support values along u (A's) and -u (B's) at time t
+    auto ha = [&](double t) { return p.a.support(ma.orientation(t).conjugate() * u); };
+    auto hb = [&](double t) { return p.b.support(mb.orientation(t).conjugate() * Vec3(-u)); };
     // the clear time itself (the prediction loop's order, span kInf: the whole bound): g_u and
     // the distance positive before it, sampled up to 1.5 spans beyond the window
     const double tc = axis_clear_time(p.a, qa, wa, p.b, p.sb.q, p.sb.w, c, u, dv, age, kInf,
@@ -239,17 +242,12 @@ void check_second_order_clear(std::uint64_t seed, bool tops) {
     for (int m = 0; m < 20 && tc > 0.0; ++m) {
       const double t = age + std::min(tc, 2.5 * span) * m / 20.0;
       const Vec3 ct = mb.position(t) - ma.position(t);
-      EXPECT_GT(u.dot(ct) - p.a.support(ma.orientation(t).conjugate() * u) -
-                    p.b.support(mb.orientation(t).conjugate() * Vec3(-u)),
-                0.0)
-          << k << " " << t;
+      EXPECT_GT(u.dot(ct) - ha(t) - hb(t), 0.0) << k << " " << t;
       if (m % 5 == 0) {
         EXPECT_GT(reference_distance_at(p, t), 0.0) << k << " " << t;
       }
     }
     // Q from central differences of the support functions and the header's M
-    auto ha = [&](double t) { return p.a.support(ma.orientation(t).conjugate() * u); };
-    auto hb = [&](double t) { return p.b.support(mb.orientation(t).conjugate() * Vec3(-u)); };
     const double d = 1e-6;
     const double ra = (ha(age + d) - ha(age - d)) / (2 * d), rb = (hb(d) - hb(-d)) / (2 * d);
     auto M = [&](const Ellipsoid& e, const Vec3& w, const Motion& m) {
