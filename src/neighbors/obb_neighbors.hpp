@@ -103,6 +103,8 @@ class ObbNeighbors {
     eps_ = margin_;
     rc_ = (ext_.array() + shell_).matrix().norm();
     kbound_l_ = shape.bounding_radius();
+    capsules_ = elongated(Vec3(ext_.array() + shell_));
+    core_ = obb_core(Vec3(ext_.array() + shell_));
   }
   // A mixture: body i is species_shapes[species_i] resized by scale_i <= max_scale[species_i].
   ObbNeighbors(const std::vector<AnyShape>& species_shapes, const std::vector<double>& max_scale,
@@ -118,6 +120,7 @@ class ObbNeighbors {
       kind.ext = std::visit([](const auto& x) { return obb_extents(x); }, species_shapes[k]);
       kinds_.push_back(kind);
       rc_ = std::max(rc_, (kind.ext.array() * max_scale[k] + shell_).matrix().norm());
+      capsules_ = capsules_ || elongated(Vec3(kind.ext.array() + shell_));
     }
   }
 
@@ -251,14 +254,37 @@ class ObbNeighbors {
 
   // Do the boxes of i and j overlap (j at its image given by the cell stencil, or the minimum
   // image when the cell list cannot tell images apart)?
-  bool overlap(std::uint32_t i, std::uint32_t j, const Vec3& shift, const Box& box) const {
+  [[gnu::always_inline]] bool overlap(std::uint32_t i, std::uint32_t j, const Vec3& shift,
+                                      const Box& box) const {
     Vec3 d = obb_[j].centre + shift - obb_[i].centre;
     if (cells_.needs_minimum_image()) d = box.minimum_image(d);
     if (d.squaredNorm() > 4.0 * rc_ * rc_) return false;  // circumspheres apart
-    return obb_overlap(obb_[i], obb_[j], Vec3(d - (obb_[j].centre - obb_[i].centre)));
+    const Obb &a = obb_[i], &b = obb_[j];
+    if (capsules_) {  // the capsules around the long axes apart (elongated boxes)
+      if constexpr (kMixture) {
+        if (obb_capsules_apart(a, obb_core(a.half), b, obb_core(b.half), d)) return false;
+      } else {
+        if (obb_capsules_apart(a, core_, b, core_, d)) return false;
+      }
+    }
+    return obb_overlap(a, b, Vec3(d - (b.centre - a.centre)));
   }
+  // The capsule test ahead of obb_overlap (geometry/obb.hpp, obb_capsules_apart), on by default
+  // where some box is elongated; off: every pair within reach goes to obb_overlap (the slow twin
+  // of the tests). The lists are the same either way (the capsule test only rules out disjoint
+  // boxes). Measured at X0 = 10, phi = 0.4 (docs/benchmarks/README.md, "Session of
+  // 2026-11-30, second part"): it rules out 91 % of the ~250 pairs within reach that a rebuild
+  // tests (228 of them; ~22 boxes overlap).
+  void set_capsule_test(bool on) { capsules_ = on; }
+  bool capsule_test() const { return capsules_; }
 
  private:
+  // A box is elongated when its longest half-extent exceeds the others by 20 % (the capsule
+  // around its long axis is then narrower than its circumsphere by a useful margin).
+  static bool elongated(const Vec3& h) {
+    const int k = obb_core(h).axis;
+    return h[k] > 1.2 * std::max(h[(k + 1) % 3], h[(k + 2) % 3]);
+  }
   static void check_shell(double shell) {
     if (!(shell > 0.0)) throw std::invalid_argument("neighbour-list shell must be positive");
   }
@@ -308,8 +334,11 @@ class ObbNeighbors {
   // load). The walk reads the cells' packed members (CellMembers): their single-precision
   // centres rule out, before any box is loaded, the ~85 % of the stencil's bodies whose
   // circumspheres are apart by more than the rounding (the exact test, overlap, decides the
-  // rest). With single-cell axes (minimum image) every member goes to the exact test. The lists
-  // are sorted, so the order of the candidates does not matter.
+  // rest). With single-cell axes (minimum image: small boxes, such as N ~ 1000 needles, where the
+  // one cell holds every body) the test takes the nearest image of the separation (near_image;
+  // where two images tie within rounding, both are as far, and the exact test takes its own);
+  // it used to send every member to the exact test. The lists are sorted, so the order of the
+  // candidates does not matter.
   template <class Take>
   void link(std::uint32_t i, const Box& box, Take take) {
     near_.clear();
@@ -319,10 +348,21 @@ class ObbNeighbors {
     // separation and its square (relative 1e-15 of the coordinates, the shift and the reach)
     const double reach = 2.0 * rc_ + members_.rounding_bound() + 1e-14 * (box.L.maxCoeff() + rc_);
     const double reach2 = reach * reach;
+    // The nearest image of a separation within one period (centres are kept inside the box):
+    // Box::near_image for |d| < 1.5 L, one compare each way per axis.
+    Vec3 half_period;
+    for (int k = 0; k < 3; ++k) half_period[k] = box.periodic[k] ? 0.5 * box.L[k] : kInf;
     cells_.for_each_stencil_cell(i, box.L, [&](std::uint32_t c, const Vec3& shift) {
       const Vec3 from = ci - shift;  // j's centre minus this: the centre separation
       for (const CellMembers::Member* m = members_.begin(c); m != members_.end(c); ++m) {
-        if (!take(m->id) || (!image && (m->centre() - from).squaredNorm() > reach2)) continue;
+        if (!take(m->id)) continue;
+        Vec3 d = m->centre() - from;
+        if (image)
+          for (int k = 0; k < 3; ++k) {
+            const double x = d[k];
+            d[k] = x > half_period[k] ? x - box.L[k] : x < -half_period[k] ? x + box.L[k] : x;
+          }
+        if (d.squaredNorm() > reach2) continue;
         __builtin_prefetch(&obb_[m->id]);
         near_.push_back({m->id, shift});
       }
@@ -352,6 +392,8 @@ class ObbNeighbors {
   std::vector<Quat> q_;
   std::vector<std::pair<std::uint32_t, Vec3>> near_;  // link's candidates (scratch)
   AdjacencyLists lists_;
+  bool capsules_ = false;     // the capsule test ahead of obb_overlap (set_capsule_test)
+  ObbCore core_;             // one shape: every box's core (the capsule test)
   std::uint64_t rebuilds_ = 0;
   mutable std::uint64_t truncated_ = 0;
 };

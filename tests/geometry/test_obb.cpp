@@ -9,7 +9,11 @@
 // (angles 1e-12 .. 1e-3), the case in which the skipped cross-product axes could matter.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
+#include <cstdio>
+#include <utility>
 
 #include "geometry/obb.hpp"
 #include "geometry/random_pairs.hpp"
@@ -70,6 +74,17 @@ Obb random_box(testing::Rng& r, double max_aspect = 10.0) {
 // Rotation by a small angle about a random axis.
 Mat3 tilt(testing::Rng& r, double angle) {
   return Eigen::AngleAxisd(angle, r.unit()).toRotationMatrix();
+}
+
+// Where b, moved from a's centre along dir, just touches a: bisection on the brute force.
+double touch_distance(const Obb& a, Obb b, const Vec3& dir) {
+  double lo = 0.0, hi = 2.0 * (a.circumradius() + b.circumradius());
+  for (int it = 0; it < 80; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    b.centre = a.centre + mid * dir;
+    (brute_overlap(a, b, Vec3::Zero()) ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
 }
 
 struct Tally {
@@ -140,14 +155,9 @@ TEST(Obb, SatAgreesWithEdgeClippingBruteForce) {
   // brute force), then placed at s* (1 -+ 1e-7): overlapping and disjoint by a hair.
   auto touch_pair = [&](Obb a, Obb b, Tally& t) {
     const Vec3 dir = r.unit();
-    double lo = 0.0, hi = 2.0 * (a.circumradius() + b.circumradius());
-    for (int it = 0; it < 80; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      b.centre = a.centre + mid * dir;
-      (brute_overlap(a, b, Vec3::Zero()) ? lo : hi) = mid;
-    }
+    const double s = touch_distance(a, b, dir);
     for (double f : {1.0 - 1e-7, 1.0 + 1e-7}) {
-      b.centre = a.centre + f * 0.5 * (lo + hi) * dir;
+      b.centre = a.centre + f * s * dir;
       t.add(obb_overlap(a, b, Vec3::Zero()), brute_overlap(a, b, Vec3::Zero()));
     }
   };
@@ -193,6 +203,125 @@ TEST(Obb, ParallelAndEdgeEdgeCases) {
     b.centre = (std::sqrt(2.0) + hb + gap) * dir;
     EXPECT_EQ(obb_overlap(a, b), brute_overlap(a, b, Vec3::Zero())) << gap;
   }
+}
+
+// The capsule pre-test (obb_capsules_apart) rules out only disjoint boxes. Each box lies in the
+// capsule around its long axis's central segment of radius sqrt(h1^2 + h2^2): checked on random
+// points of random boxes. Against the brute force: random needles (aspect up to 20), nearly
+// parallel ones (tilts 1e-12 .. 0.1, across the 1e-12 cut of 1 - (u.v)^2) and pairs a hair from
+// touching (bisection on the brute force, then 1 -+ 1e-7), some of them exactly parallel (the
+// tangent-plane bound of the test, not its starting point, must carry those); and the
+// adversarial case where the capsules touch exactly where the boxes do, corner to corner (the
+// boxes' corners lie on their capsules; a quarter of them nearly parallel): overlapping by 1e-6 of their size it must not rule the pair out, apart by as much it
+// does (the rounding slack is ~1e-9 of the scale). It also rules out most disjoint random needles.
+TEST(Obb, CapsuleTestRulesOutOnlyDisjointBoxes) {
+  testing::Rng r(20261130);
+  auto long_axis = [](const Vec3& h) {
+    int k = 0;
+    for (int i = 1; i < 3; ++i)
+      if (h[i] > h[k]) k = i;
+    return k;
+  };
+  auto apart = [&](const Obb& a, const Obb& b) {
+    const ObbCore ca = obb_core(a.half), cb = obb_core(b.half);
+    EXPECT_EQ(ca.axis, long_axis(a.half));
+    return obb_capsules_apart(a, ca, b, cb, Vec3(b.centre - a.centre));
+  };
+  // containment: box points within rho of the core segment
+  double worst = -kInf;
+  for (int k = 0; k < hb::testing::scaled_count(2000, 0.1); ++k) {
+    const Obb b = random_box(r, 20.0);
+    const int ax = long_axis(b.half);
+    const double rho = std::sqrt(b.half.squaredNorm() - b.half[ax] * b.half[ax]);
+    for (int m = 0; m < 8; ++m) {
+      Vec3 x = b.centre;
+      for (int i = 0; i < 3; ++i) x += r.uni(-1.0, 1.0) * b.half[i] * b.axes.col(i);
+      const Vec3 rel = x - b.centre;
+      const double s = std::clamp(rel.dot(b.axes.col(ax)), -b.half[ax], b.half[ax]);
+      worst = std::max(worst, (rel - s * b.axes.col(ax)).norm() - rho);
+    }
+  }
+  EXPECT_LE(worst, 1e-12);
+  Tally random, parallel, touching;
+  long random_decided = 0, random_disjoint = 0;
+  auto add = [&](Tally& t, const Obb& a, const Obb& b) {
+    const bool ref = brute_overlap(a, b, Vec3::Zero());
+    t.add(!apart(a, b), ref);  // "not apart" plays "overlap": a false disjoint is an error
+    return ref;
+  };
+  for (int k = 0; k < hb::testing::scaled_count(40000, 0.05); ++k) {
+    Obb a = random_box(r, 20.0), b = random_box(r, 20.0);
+    a.centre = r.ball(3.0);
+    b.centre = r.ball(3.0);
+    const bool ref = add(random, a, b);
+    random_disjoint += !ref;
+    random_decided += !ref && apart(a, b);
+  }
+  for (int k = 0; k < hb::testing::scaled_count(20000, 0.05); ++k) {
+    Obb a = random_box(r, 20.0), b = random_box(r, 20.0);
+    b.axes = k % 8 ? Mat3(tilt(r, r.log_uni(1e-12, 0.1)) * a.axes) : a.axes;
+    a.centre = r.ball(2.0);
+    b.centre = r.ball(2.0);
+    add(parallel, a, b);
+  }
+  for (int k = 0; k < hb::testing::scaled_count(10000, 0.05); ++k) {
+    Obb a = random_box(r, 20.0), b = random_box(r, 20.0);
+    if (k % 4 == 1) b.axes = tilt(r, r.log_uni(1e-12, 0.1)) * a.axes;
+    if (k % 4 == 3) b.axes = a.axes;
+    const Vec3 dir = r.unit();
+    const double s = touch_distance(a, b, dir);
+    for (double f : {1.0 - 1e-7, 1.0 + 1e-7}) {
+      b.centre = a.centre + f * s * dir;
+      add(touching, a, b);
+    }
+  }
+  // corner to corner: a's corner c = centre + h0 u0 + h1 u1 + h2 u2 is its support point along
+  // n = (h1 u1 + h2 u2) / rho_a (normal to u0); b (long axis v0 normal to n, turned about v0 so
+  // that its corner offset h1' v1 + h2' v2 is -rho_b n) has its corner at c + gap n. The plane
+  // n.x = n.c + gap / 2 separates them for gap > 0; for gap < 0 the corners cut into each other.
+  // The segments' closest points are their ends, rho_a + rho_b + gap apart.
+  long corner_pairs = 0, corner_apart_overlapping = 0, corner_apart_disjoint = 0;
+  for (int k = 0; k < hb::testing::scaled_count(4000, 0.05); ++k) {
+    Obb a = random_box(r, 20.0), b = random_box(r, 20.0);
+    const Vec3 h = a.half, hb_ = b.half;
+    const double rho_a = std::hypot(h[1], h[2]), rho_b = std::hypot(hb_[1], hb_[2]);
+    const Vec3 n = (h[1] * a.axes.col(1) + h[2] * a.axes.col(2)) / rho_a;
+    const Vec3 c = a.centre + h[0] * a.axes.col(0) + rho_a * n;
+    Vec3 v0;
+    if (k % 4) {  // normal to n: at random
+      v0 = r.unit();
+      v0 = (v0 - v0.dot(n) * n).normalized();
+    } else {  // normal to n, within 1e-12 .. 1e-2 rad of a's axis (nearly parallel needles)
+      const double eps = r.log_uni(1e-12, 1e-2);
+      v0 = std::cos(eps) * a.axes.col(0) + std::sin(eps) * n.cross(a.axes.col(0));
+    }
+    const Vec3 m = -n, p = v0.cross(m);
+    const double ca = hb_[1] / rho_b, sa = -hb_[2] / rho_b;
+    b.axes.col(0) = v0;
+    b.axes.col(1) = ca * m + sa * p;
+    b.axes.col(2) = -sa * m + ca * p;
+    for (double sgn : {-1.0, 1.0}) {
+      const double gap = sgn * 1e-6 * (h.norm() + hb_.norm());
+      b.centre = c + gap * n - hb_[0] * v0 + rho_b * n;  // corner = centre + h0' v0 - rho_b n
+      const bool ref = brute_overlap(a, b, Vec3::Zero());
+      ASSERT_EQ(ref, sgn < 0.0) << k;  // the construction itself
+      ++corner_pairs;
+      (ref ? corner_apart_overlapping : corner_apart_disjoint) += apart(a, b);
+    }
+  }
+  for (const auto& [name, t] : {std::pair{"random needles", random}, std::pair{"near-parallel", parallel},
+                                std::pair{"touching", touching}}) {
+    std::printf("[ capsule ] %-16s pairs %6ld  overlapping %6ld  ruled out %6ld  wrongly %ld\n", name,
+                t.pairs, t.overlap, t.pairs - t.overlap - t.false_overlap, t.false_disjoint);
+    EXPECT_EQ(t.false_disjoint, 0) << name;
+  }
+  std::printf("[ capsule ] corner to corner: %ld pairs, ruled out %ld of the disjoint, %ld of the "
+              "overlapping; random needles: %ld of %ld disjoint ruled out\n",
+              corner_pairs, corner_apart_disjoint, corner_apart_overlapping, random_decided,
+              random_disjoint);
+  EXPECT_EQ(corner_apart_overlapping, 0);
+  EXPECT_EQ(corner_apart_disjoint, corner_pairs / 2);  // a gap of 1e-6 is beyond the slack
+  EXPECT_GT(random_decided, random_disjoint / 2);        // not a vacuous test
 }
 
 }  // namespace

@@ -68,14 +68,19 @@ double min_clearance(const NB& nb, const State& s, const Ellipsoid& e, double no
   return m;
 }
 
-TEST(ObbNeighbors, RandomRebuildsKeepListsEqualToBruteForce) {
+// Random poses and teleports: the lists against the brute force after every round of rebuilds.
+// Boxes of 9 x 10 x 11 hold 3 cells per axis (the cell stencil with image shifts); boxes of
+// 6 x 7 x 8 one (every body a candidate, minimum image: link's nearest-image pre-test). The
+// needles' boxes are elongated, so the capsule test runs ahead of the SAT; its twin (the test
+// off) builds the same lists from a snapshot.
+void random_rebuilds_keep_lists_equal_to_brute_force(const Vec3& L) {
   std::mt19937_64 g(12345);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   std::normal_distribution<double> nrm(0.0, 1.0);
   const Ellipsoid e{1.0, 0.3, 0.3};
   const std::size_t n = 300;
   Box box;
-  box.L = Vec3(9.0, 10.0, 11.0);
+  box.L = L;
   State s;
   s.resize(n);
   auto random_pose = [&](std::uint32_t i) {
@@ -85,6 +90,7 @@ TEST(ObbNeighbors, RandomRebuildsKeepListsEqualToBruteForce) {
   for (std::uint32_t i = 0; i < n; ++i) random_pose(i);
   std::vector<Vec3> unwrapped = s.r;
   ObbNeighbors<Ellipsoid> nb(e, 0.2);
+  EXPECT_TRUE(nb.capsule_test());  // elongated boxes: on by default
   nb.init(box, s, 0.0);
   expect_lists_match_brute_force(nb, box, n);
   auto noop = [](std::uint32_t, const Vec3&) {};
@@ -119,6 +125,21 @@ TEST(ObbNeighbors, RandomRebuildsKeepListsEqualToBruteForce) {
     EXPECT_TRUE(std::is_sorted(a.begin(), a.end()));
     EXPECT_EQ(std::adjacent_find(a.begin(), a.end()), a.end());  // no body twice
   }
+  ObbNeighbors<Ellipsoid> twin(e, 0.2);  // the capsule test off: every pair to the SAT
+  twin.set_capsule_test(false);
+  twin.restore(box, s, nb.snapshot());
+  long differ = 0;
+  for (std::uint32_t i = 0; i < n; ++i)
+    differ += !std::equal(nb.lists().begin(i), nb.lists().end(i), twin.lists().begin(i),
+                          twin.lists().end(i));
+  EXPECT_EQ(differ, 0);
+}
+
+TEST(ObbNeighbors, RandomRebuildsKeepListsEqualToBruteForce) {
+  random_rebuilds_keep_lists_equal_to_brute_force(Vec3(9.0, 10.0, 11.0));
+}
+TEST(ObbNeighbors, RandomRebuildsInASingleCellKeepListsEqualToBruteForce) {
+  random_rebuilds_keep_lists_equal_to_brute_force(Vec3(6.0, 7.0, 8.0));
 }
 
 TEST(ObbNeighbors, RunKeepsListsExactAndBodiesInsideTheirBoxes) {
