@@ -18,6 +18,7 @@
 #include <cmath>
 
 #include "geometry/plane.hpp"
+#include "geometry/segment.hpp"
 #include "math/types.hpp"
 
 namespace hb {
@@ -100,7 +101,7 @@ struct ObbCore {
   double half = 0.0, rho = 0.0;
 };
 inline ObbCore obb_core(const Vec3& half) {
-  const int k = half[0] >= half[1] ? (half[0] >= half[2] ? 0 : 2) : (half[1] >= half[2] ? 1 : 2);
+  const int k = core_segment(half).axis;  // the largest half-extent (the first of equal ones)
   return {k, half[k], std::sqrt(half.squaredNorm() - half[k] * half[k])};
 }
 
