@@ -52,6 +52,7 @@
 #include "contact/escape_time.hpp"
 #include "events/event.hpp"
 #include "geometry/obb.hpp"
+#include "geometry/segment.hpp"
 #include "neighbors/cell_list.hpp"
 #include "neighbors/cell_members.hpp"
 #include "neighbors/shell_neighbors.hpp"
@@ -282,8 +283,8 @@ class ObbNeighbors {
   // A box is elongated when its longest half-extent exceeds the others by 20 % (the capsule
   // around its long axis is then narrower than its circumsphere by a useful margin).
   static bool elongated(const Vec3& h) {
-    const int k = obb_core(h).axis;
-    return h[k] > 1.2 * std::max(h[(k + 1) % 3], h[(k + 2) % 3]);
+    const CoreSegment c = core_segment(h);  // its long axis and the second largest extent
+    return h[c.axis] > 1.2 * c.thick;
   }
   static void check_shell(double shell) {
     if (!(shell > 0.0)) throw std::invalid_argument("neighbour-list shell must be positive");
