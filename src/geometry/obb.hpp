@@ -105,6 +105,23 @@ inline ObbCore obb_core(const Vec3& half) {
   return {k, half[k], std::sqrt(half.squaredNorm() - half[k] * half[k])};
 }
 
+// The cheapest test of the three for elongated boxes, ahead of obb_capsules_apart below: true
+// only when the boxes are proven disjoint. Box a lies inside the capsule around its core segment
+// (core ca, radius ca.rho, see below); box b lies inside the ball of radius rb around its centre
+// (rb >= its circumradius |b.half|). If b's centre (d: b's centre at its image minus a's) is more
+// than ca.rho + rb from the segment, the capsule and the ball are apart, and so are the boxes.
+// The distance is to the clamped projection s = clamp(u.d, -h, h), the segment's nearest point
+// (exact up to rounding, ~1e-15 (h + |d|)^2); the test asks for the same 2e-9 (h^2 + |d|^2) beyond
+// (rho + rb)^2 as obb_capsules_apart. About 20 instructions against ~150: at X0 = 10 the ball
+// reaches fewer than half the pairs within the circumspheres' reach (docs/benchmarks/README.md,
+// "Session of 2026-12-01").
+[[gnu::always_inline]] inline bool obb_capsule_ball_apart(const Obb& a, const ObbCore& ca, double rb, const Vec3& d) {
+  const Vec3 u = a.axes.col(ca.axis);
+  const double s = std::clamp(u.dot(d), -ca.half, ca.half);
+  const double reach = ca.rho + rb;
+  return (d - s * u).squaredNorm() > reach * reach + 2e-9 * (ca.half * ca.half + d.squaredNorm());
+}
+
 // A cheaper test ahead of obb_overlap for elongated boxes: true only when the boxes are proven
 // disjoint (false: not decided here). Box a lies inside the capsule around the central segment of
 // its long axis (core ca: half-length ca.half) of radius ca.rho: a point c + s u_k + y u_i + z u_j

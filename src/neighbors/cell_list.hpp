@@ -163,7 +163,7 @@ class CellList {
   // shift of its bodies as for_each_neighbor gives it (for a caller that keeps its own record
   // of each cell's bodies: neighbors/cell_members.hpp).
   template <class Fn>
-  void for_each_stencil_cell(std::uint32_t i, const Vec3& L, Fn&& fn) const {
+  [[gnu::always_inline]] void for_each_stencil_cell(std::uint32_t i, const Vec3& L, Fn&& fn) const {
     std::array<int, 3> lo{-1, -1, -1}, hi{1, 1, 1};
     for (int m = 0; m < 3; ++m)
       if (nc_[m] == 1) lo[m] = hi[m] = 0;
@@ -207,7 +207,7 @@ class CellList {
   }
   // The cells of visit, each once: fn(cell index, image shift).
   template <class Fn>
-  void visit_cells(const std::array<int, 3>& c, const std::array<int, 3>& lo,
+  [[gnu::always_inline]] void visit_cells(const std::array<int, 3>& c, const std::array<int, 3>& lo,
                    const std::array<int, 3>& hi, const Vec3& L, Fn&& fn) const {
     int xs[3], ys[3], zs[3];
     double sx[3], sy[3], sz[3];

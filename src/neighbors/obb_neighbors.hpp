@@ -253,19 +253,23 @@ class ObbNeighbors {
     return false;
   }
 
-  // Do the boxes of i and j overlap (j at its image given by the cell stencil, or the minimum
-  // image when the cell list cannot tell images apart)?
-  [[gnu::always_inline]] bool overlap(std::uint32_t i, std::uint32_t j, const Vec3& shift,
-                                      const Box& box) const {
-    Vec3 d = obb_[j].centre + shift - obb_[i].centre;
-    if (cells_.needs_minimum_image()) d = box.minimum_image(d);
+  // Do the boxes of i and j overlap (d: j's centre at its image minus i's, link below)?
+  [[gnu::always_inline]] bool overlap(std::uint32_t i, std::uint32_t j, const Vec3& d) const {
     if (d.squaredNorm() > 4.0 * rc_ * rc_) return false;  // circumspheres apart
     const Obb &a = obb_[i], &b = obb_[j];
     if (capsules_) {  // the capsules around the long axes apart (elongated boxes)
+      // first each capsule against the other's circumsphere (obb_capsule_ball_apart), then the
+      // two capsules
       if constexpr (kMixture) {
-        if (obb_capsules_apart(a, obb_core(a.half), b, obb_core(b.half), d)) return false;
+        const ObbCore ca = obb_core(a.half), cb = obb_core(b.half);
+        if (obb_capsule_ball_apart(a, ca, b.half.norm(), d) ||
+            obb_capsule_ball_apart(b, cb, a.half.norm(), Vec3(-d)) ||
+            obb_capsules_apart(a, ca, b, cb, d))
+          return false;
       } else {
-        if (obb_capsules_apart(a, core_, b, core_, d)) return false;
+        if (obb_capsule_ball_apart(a, core_, rc_, d) || obb_capsule_ball_apart(b, core_, rc_, Vec3(-d)) ||
+            obb_capsules_apart(a, core_, b, core_, d))
+          return false;
       }
     }
     return obb_overlap(a, b, Vec3(d - (b.centre - a.centre)));
@@ -349,27 +353,37 @@ class ObbNeighbors {
     // separation and its square (relative 1e-15 of the coordinates, the shift and the reach)
     const double reach = 2.0 * rc_ + members_.rounding_bound() + 1e-14 * (box.L.maxCoeff() + rc_);
     const double reach2 = reach * reach;
-    // The nearest image of a separation within one period (centres are kept inside the box):
-    // Box::near_image for |d| < 1.5 L, one compare each way per axis.
-    Vec3 half_period;
-    for (int k = 0; k < 3; ++k) half_period[k] = box.periodic[k] ? 0.5 * box.L[k] : kInf;
+    // The nearest image of a separation within one period (centres are kept inside the box, so
+    // |x| < P along each axis). The walk needs only its length along an axis: |x| folded once,
+    // min(|x|, P - |x|), with no branch (P = kInf along an axis that is not periodic). The exact
+    // test takes the signed separation, Box::near_image for |x| < 1.5 P: one compare each way per
+    // axis (it used Box::minimum_image, three divisions).
+    Vec3 period, half_period;
+    for (int k = 0; k < 3; ++k) {
+      period[k] = box.periodic[k] ? box.L[k] : kInf;
+      half_period[k] = 0.5 * period[k];
+    }
     cells_.for_each_stencil_cell(i, box.L, [&](std::uint32_t c, const Vec3& shift) {
       const Vec3 from = ci - shift;  // j's centre minus this: the centre separation
       for (const CellMembers::Member* m = members_.begin(c); m != members_.end(c); ++m) {
         if (!take(m->id)) continue;
         Vec3 d = m->centre() - from;
-        if (image)
-          for (int k = 0; k < 3; ++k) {
-            const double x = d[k];
-            d[k] = x > half_period[k] ? x - box.L[k] : x < -half_period[k] ? x + box.L[k] : x;
-          }
+        if (image) {
+          const Vec3 a = d.cwiseAbs();
+          d = a.cwiseMin(period - a);
+        }
         if (d.squaredNorm() > reach2) continue;
         __builtin_prefetch(&obb_[m->id]);
         near_.push_back({m->id, shift});
       }
     });
-    for (const auto& [j, shift] : near_)
-      if (overlap(i, j, shift, box)) lists_.add(i, j), lists_.add(j, i);
+    for (const auto& [j, shift] : near_) {
+      Vec3 d = obb_[j].centre + shift - ci;
+      if (image)
+        for (int k = 0; k < 3; ++k)
+          d[k] = d[k] > half_period[k] ? d[k] - period[k] : d[k] < -half_period[k] ? d[k] + period[k] : d[k];
+      if (overlap(i, j, d)) lists_.add(i, j), lists_.add(j, i);
+    }
   }
 
   // A species of a mixture at scale 1.

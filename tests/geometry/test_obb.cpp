@@ -13,6 +13,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <utility>
 
 #include "geometry/obb.hpp"
@@ -214,6 +215,57 @@ TEST(Obb, ParallelAndEdgeEdgeCases) {
 // adversarial case where the capsules touch exactly where the boxes do, corner to corner (the
 // boxes' corners lie on their capsules; a quarter of them nearly parallel): overlapping by 1e-6 of their size it must not rule the pair out, apart by as much it
 // does (the rounding slack is ~1e-9 of the scale). It also rules out most disjoint random needles.
+// The random and the touching pairs of the capsule tests below: `apart` (a test that may only
+// rule out disjoint boxes) against the edge-clipping brute force. Random needles with centres in
+// a ball of radius 3 (counting the disjoint pairs and those apart rules out), then pairs 1e-7
+// from touching along a random direction (b tilted from a, or parallel to it, in a quarter each).
+template <class Apart>
+void tally_random_pairs(testing::Rng& r, const Apart& apart, Tally& t, long& decided, long& disjoint) {
+  for (int k = 0; k < hb::testing::scaled_count(40000, 0.05); ++k) {
+    Obb a = random_box(r, 20.0), b = random_box(r, 20.0);
+    a.centre = r.ball(3.0);
+    b.centre = r.ball(3.0);
+    const bool ref = brute_overlap(a, b, Vec3::Zero());
+    t.add(!apart(a, b), ref);  // "not apart" plays "overlap": a false disjoint is an error
+    disjoint += !ref;
+    decided += !ref && apart(a, b);
+  }
+}
+template <class Apart>
+void tally_touching_pairs(testing::Rng& r, const Apart& apart, Tally& t) {
+  for (int k = 0; k < hb::testing::scaled_count(10000, 0.05); ++k) {
+    Obb a = random_box(r, 20.0), b = random_box(r, 20.0);
+    if (k % 4 == 1) b.axes = tilt(r, r.log_uni(1e-12, 0.1)) * a.axes;
+    if (k % 4 == 3) b.axes = a.axes;
+    const Vec3 dir = r.unit();
+    const double s = touch_distance(a, b, dir);
+    for (double f : {1.0 - 1e-7, 1.0 + 1e-7}) {
+      b.centre = a.centre + f * s * dir;
+      t.add(!apart(a, b), brute_overlap(a, b, Vec3::Zero()));
+    }
+  }
+}
+
+// The checks and the printed counts of the capsule tests below: no overlapping pair ruled out in
+// any set, all of the disjoint corner pairs and none of the overlapping ones ruled out, and at
+// least 1 / `share` of the random disjoint pairs ruled out (not a vacuous test).
+void check_apart_tallies(const char* tag, std::initializer_list<std::pair<const char*, Tally>> sets,
+                         long corner_pairs, long corner_apart_disjoint, long corner_apart_overlapping,
+                         long random_decided, long random_disjoint, long share) {
+  for (const auto& [name, t] : sets) {
+    std::printf("[ %s ] %-16s pairs %6ld  overlapping %6ld  ruled out %6ld  wrongly %ld\n", tag,
+                name, t.pairs, t.overlap, t.pairs - t.overlap - t.false_overlap, t.false_disjoint);
+    EXPECT_EQ(t.false_disjoint, 0) << name;
+  }
+  std::printf("[ %s ] corner to corner: %ld pairs, ruled out %ld of the disjoint, %ld of the "
+              "overlapping; random needles: %ld of %ld disjoint ruled out\n",
+              tag, corner_pairs, corner_apart_disjoint, corner_apart_overlapping, random_decided,
+              random_disjoint);
+  EXPECT_EQ(corner_apart_overlapping, 0);
+  EXPECT_EQ(corner_apart_disjoint, corner_pairs / 2);  // a gap of 1e-6 is beyond the slack
+  EXPECT_GT(random_decided, random_disjoint / share);
+}
+
 TEST(Obb, CapsuleTestRulesOutOnlyDisjointBoxes) {
   testing::Rng r(20261130);
   auto long_axis = [](const Vec3& h) {
@@ -249,14 +301,7 @@ TEST(Obb, CapsuleTestRulesOutOnlyDisjointBoxes) {
     t.add(!apart(a, b), ref);  // "not apart" plays "overlap": a false disjoint is an error
     return ref;
   };
-  for (int k = 0; k < hb::testing::scaled_count(40000, 0.05); ++k) {
-    Obb a = random_box(r, 20.0), b = random_box(r, 20.0);
-    a.centre = r.ball(3.0);
-    b.centre = r.ball(3.0);
-    const bool ref = add(random, a, b);
-    random_disjoint += !ref;
-    random_decided += !ref && apart(a, b);
-  }
+  tally_random_pairs(r, apart, random, random_decided, random_disjoint);
   for (int k = 0; k < hb::testing::scaled_count(20000, 0.05); ++k) {
     Obb a = random_box(r, 20.0), b = random_box(r, 20.0);
     b.axes = k % 8 ? Mat3(tilt(r, r.log_uni(1e-12, 0.1)) * a.axes) : a.axes;
@@ -264,17 +309,7 @@ TEST(Obb, CapsuleTestRulesOutOnlyDisjointBoxes) {
     b.centre = r.ball(2.0);
     add(parallel, a, b);
   }
-  for (int k = 0; k < hb::testing::scaled_count(10000, 0.05); ++k) {
-    Obb a = random_box(r, 20.0), b = random_box(r, 20.0);
-    if (k % 4 == 1) b.axes = tilt(r, r.log_uni(1e-12, 0.1)) * a.axes;
-    if (k % 4 == 3) b.axes = a.axes;
-    const Vec3 dir = r.unit();
-    const double s = touch_distance(a, b, dir);
-    for (double f : {1.0 - 1e-7, 1.0 + 1e-7}) {
-      b.centre = a.centre + f * s * dir;
-      add(touching, a, b);
-    }
-  }
+  tally_touching_pairs(r, apart, touching);
   // corner to corner: a's corner c = centre + h0 u0 + h1 u1 + h2 u2 is its support point along
   // n = (h1 u1 + h2 u2) / rho_a (normal to u0); b (long axis v0 normal to n, turned about v0 so
   // that its corner offset h1' v1 + h2' v2 is -rho_b n) has its corner at c + gap n. The plane
@@ -309,19 +344,48 @@ TEST(Obb, CapsuleTestRulesOutOnlyDisjointBoxes) {
       (ref ? corner_apart_overlapping : corner_apart_disjoint) += apart(a, b);
     }
   }
-  for (const auto& [name, t] : {std::pair{"random needles", random}, std::pair{"near-parallel", parallel},
-                                std::pair{"touching", touching}}) {
-    std::printf("[ capsule ] %-16s pairs %6ld  overlapping %6ld  ruled out %6ld  wrongly %ld\n", name,
-                t.pairs, t.overlap, t.pairs - t.overlap - t.false_overlap, t.false_disjoint);
-    EXPECT_EQ(t.false_disjoint, 0) << name;
+  check_apart_tallies("capsule", {{"random needles", random}, {"near-parallel", parallel}, {"touching", touching}},
+                      corner_pairs, corner_apart_disjoint, corner_apart_overlapping, random_decided,
+                      random_disjoint, 2);
+}
+
+// obb_capsule_ball_apart (box a's capsule against box b's circumsphere, the cheap test ahead of
+// obb_capsules_apart in the neighbour-list rebuilds) against the edge-clipping brute force: random
+// pairs, pairs 1e-7 from touching, and pairs built so that the ball and the capsule touch where
+// the boxes do (b's corner on the line from its centre normal to a's segment, at a's corner).
+TEST(Obb, CapsuleBallTestRulesOutOnlyDisjointBoxes) {
+  testing::Rng r(20261201);
+  auto apart = [](const Obb& a, const Obb& b) {
+    return obb_capsule_ball_apart(a, obb_core(a.half), b.circumradius(), Vec3(b.centre - a.centre));
+  };
+  Tally random, touching;
+  long random_decided = 0, random_disjoint = 0;
+  tally_random_pairs(r, apart, random, random_decided, random_disjoint);
+  tally_touching_pairs(r, apart, touching);
+  // a's corner c = centre + h0 u0 + rho_a n (n = (h1 u1 + h2 u2) / rho_a, normal to u0) is
+  // rho_a from the segment's end; b turned so that its corner offset b.axes b.half is -rb n, its
+  // centre at c + (gap + rb) n: the centre is rho_a + rb + gap from a's segment, and the plane
+  // n.x = n.c + gap / 2 separates the boxes for gap > 0; for gap < 0 b's corner is inside a.
+  long corner_pairs = 0, corner_apart_overlapping = 0, corner_apart_disjoint = 0;
+  for (int k = 0; k < hb::testing::scaled_count(4000, 0.05); ++k) {
+    Obb a = random_box(r, 20.0), b = random_box(r, 20.0);
+    const Vec3 h = a.half;
+    const double rho_a = std::hypot(h[1], h[2]), rb = b.circumradius();
+    const Vec3 n = (h[1] * a.axes.col(1) + h[2] * a.axes.col(2)) / rho_a;
+    const Vec3 c = a.centre + h[0] * a.axes.col(0) + rho_a * n;
+    const Vec3 o = b.axes * b.half;
+    b.axes = Eigen::Quaterniond::FromTwoVectors(o, -n).toRotationMatrix() * b.axes;
+    for (double sgn : {-1.0, 1.0}) {
+      const double gap = sgn * 1e-6 * (h.norm() + rb);
+      b.centre = c + (gap + rb) * n;
+      const bool ref = brute_overlap(a, b, Vec3::Zero());
+      ASSERT_EQ(ref, sgn < 0.0) << k;  // the construction itself
+      ++corner_pairs;
+      (ref ? corner_apart_overlapping : corner_apart_disjoint) += apart(a, b);
+    }
   }
-  std::printf("[ capsule ] corner to corner: %ld pairs, ruled out %ld of the disjoint, %ld of the "
-              "overlapping; random needles: %ld of %ld disjoint ruled out\n",
-              corner_pairs, corner_apart_disjoint, corner_apart_overlapping, random_decided,
-              random_disjoint);
-  EXPECT_EQ(corner_apart_overlapping, 0);
-  EXPECT_EQ(corner_apart_disjoint, corner_pairs / 2);  // a gap of 1e-6 is beyond the slack
-  EXPECT_GT(random_decided, random_disjoint / 2);        // not a vacuous test
+  check_apart_tallies("capsule-ball", {{"random needles", random}, {"touching", touching}}, corner_pairs,
+                      corner_apart_disjoint, corner_apart_overlapping, random_decided, random_disjoint, 4);
 }
 
 }  // namespace
