@@ -274,12 +274,13 @@ class ObbNeighbors {
     }
     return obb_overlap(a, b, Vec3(d - (b.centre - a.centre)));
   }
-  // The capsule test ahead of obb_overlap (geometry/obb.hpp, obb_capsules_apart), on by default
-  // where some box is elongated; off: every pair within reach goes to obb_overlap (the slow twin
-  // of the tests). The lists are the same either way (the capsule test only rules out disjoint
-  // boxes). Measured at X0 = 10, phi = 0.4 (docs/benchmarks/README.md, "Session of
-  // 2026-11-30, second part"): it rules out 91 % of the ~250 pairs within reach that a rebuild
-  // tests (228 of them; ~22 go on to the SAT, and ~20 overlap).
+  // The capsule tests ahead of obb_overlap (geometry/obb.hpp: obb_capsule_ball_apart both ways,
+  // then obb_capsules_apart), on by default where some box is elongated; off: every pair within
+  // reach goes to obb_overlap (the slow twin of the tests). The lists are the same either way
+  // (the capsule tests only rule out disjoint boxes). Measured at X0 = 10, phi = 0.4 (calls per
+  // rebuild; docs/benchmarks/README.md, "Session of 2026-12-01"): of the ~400 pairs within the
+  // circumspheres' reach, the ball tests rule out ~206 and the two-capsule test ~170; ~24 go on
+  // to the SAT.
   void set_capsule_test(bool on) { capsules_ = on; }
   bool capsule_test() const { return capsules_; }
 
@@ -349,10 +350,8 @@ class ObbNeighbors {
     near_.clear();
     const Vec3 ci = obb_[i].centre;
     const bool image = cells_.needs_minimum_image();
-    // the cut-off widened by the centres' rounding, and by the double-precision rounding of the
-    // separation and its square (relative 1e-15 of the coordinates, the shift and the reach)
-    const double reach = 2.0 * rc_ + members_.rounding_bound() + 1e-14 * (box.L.maxCoeff() + rc_);
-    const double reach2 = reach * reach;
+    // the cut-off widened by the centres' rounding (for_each_within adds its own arithmetic's)
+    const double reach = 2.0 * rc_ + members_.rounding_bound();
     // The nearest image of a separation within one period (centres are kept inside the box, so
     // |x| < P along each axis). The walk needs only its length along an axis: |x| folded once,
     // min(|x|, P - |x|), with no branch (P = kInf along an axis that is not periodic). The exact
@@ -363,19 +362,14 @@ class ObbNeighbors {
       period[k] = box.periodic[k] ? box.L[k] : kInf;
       half_period[k] = 0.5 * period[k];
     }
+    const Vec3 fold = image ? period : Vec3::Constant(kInf);  // the walk's periods
     cells_.for_each_stencil_cell(i, box.L, [&](std::uint32_t c, const Vec3& shift) {
-      const Vec3 from = ci - shift;  // j's centre minus this: the centre separation
-      for (const CellMembers::Member* m = members_.begin(c); m != members_.end(c); ++m) {
-        if (!take(m->id)) continue;
-        Vec3 d = m->centre() - from;
-        if (image) {
-          const Vec3 a = d.cwiseAbs();
-          d = a.cwiseMin(period - a);
-        }
-        if (d.squaredNorm() > reach2) continue;
-        __builtin_prefetch(&obb_[m->id]);
-        near_.push_back({m->id, shift});
-      }
+      // j's centre minus ci - shift: the centre separation
+      members_.for_each_within(c, Vec3(ci - shift), fold, reach, [&](std::uint32_t j) {
+        if (!take(j)) return;
+        __builtin_prefetch(&obb_[j]);
+        near_.push_back({j, shift});
+      });
     });
     for (const auto& [j, shift] : near_) {
       Vec3 d = obb_[j].centre + shift - ci;
