@@ -352,17 +352,14 @@ class ObbNeighbors {
     const bool image = cells_.needs_minimum_image();
     // the cut-off widened by the centres' rounding (for_each_within adds its own arithmetic's)
     const double reach = 2.0 * rc_ + members_.rounding_bound();
-    // The nearest image of a separation within one period (centres are kept inside the box, so
-    // |x| < P along each axis). The walk needs only its length along an axis: |x| folded once,
-    // min(|x|, P - |x|), with no branch (P = kInf along an axis that is not periodic). The exact
-    // test takes the signed separation, Box::near_image for |x| < 1.5 P: one compare each way per
-    // axis (it used Box::minimum_image, three divisions).
-    Vec3 period, half_period;
-    for (int k = 0; k < 3; ++k) {
-      period[k] = box.periodic[k] ? box.L[k] : kInf;
-      half_period[k] = 0.5 * period[k];
-    }
-    const Vec3 fold = image ? period : Vec3::Constant(kInf);  // the walk's periods
+    // With single-cell axes, the nearest image of a separation (centres are kept inside the box,
+    // so |x| < L along each axis): the walk folds each axis once (CellMembers::for_each_within,
+    // P = kInf along an axis that is not periodic), and the exact test takes Box::near_image, one
+    // compare each way per axis here (it used Box::minimum_image, three divisions).
+    Vec3 fold = Vec3::Constant(kInf);  // the walk's periods
+    if (image)
+      for (int k = 0; k < 3; ++k)
+        if (box.periodic[k]) fold[k] = box.L[k];
     cells_.for_each_stencil_cell(i, box.L, [&](std::uint32_t c, const Vec3& shift) {
       // j's centre minus ci - shift: the centre separation
       members_.for_each_within(c, Vec3(ci - shift), fold, reach, [&](std::uint32_t j) {
@@ -372,11 +369,8 @@ class ObbNeighbors {
       });
     });
     for (const auto& [j, shift] : near_) {
-      Vec3 d = obb_[j].centre + shift - ci;
-      if (image)
-        for (int k = 0; k < 3; ++k)
-          d[k] = d[k] > half_period[k] ? d[k] - period[k] : d[k] < -half_period[k] ? d[k] + period[k] : d[k];
-      if (overlap(i, j, d)) lists_.add(i, j), lists_.add(j, i);
+      const Vec3 d = obb_[j].centre + shift - ci;
+      if (overlap(i, j, image ? box.near_image(d) : d)) lists_.add(i, j), lists_.add(j, i);
     }
   }
 
