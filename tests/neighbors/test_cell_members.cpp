@@ -2,7 +2,8 @@
 // after random moves between cells (with overflows that grow the capacity), every cell holds the
 // same bodies, each member's centre is its body's to within rounding_bound(), and the stencil
 // walk of CellList::for_each_stencil_cell over the members finds the bodies, with their image
-// shifts, that CellList::for_each_neighbor finds.
+// shifts, that CellList::for_each_neighbor finds; and the walk's distance test
+// (for_each_within) against double precision.
 #include <gtest/gtest.h>
 
 #include <pcg_random.hpp>
@@ -67,4 +68,64 @@ TEST(CellMembers, HoldWhatTheLinkedCellsHold) {
     EXPECT_EQ(a, b) << "body " << i;
   }
   EXPECT_THROW(members.remove(0, 100000), std::logic_error);
+}
+
+// for_each_within against the distance in double precision on the stored centres, its slow
+// twin: in cells of 1 to 13 members, after removals that move the last member into a hole (and
+// a growth of the capacity), with members placed within 1e-7 of the cut-off on both sides, along
+// periodic axes folded once and an axis without a period. Every member within reach is reported
+// exactly once; nothing further than the documented widening (1e-5 S) is.
+TEST(CellMembers, WalkFindsTheMembersWithinReach) {
+  pcg32 rng(29);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const Vec3 L(10.0, 8.0, 12.0);
+  const Vec3 period(L.x(), L.y(), kInf);  // z has no period
+  const double reach = 3.0;
+  std::size_t reported = 0, near_cut = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    CellMembers members;
+    members.init(1, 4);  // one cell; 13 members overflow it (capacity 16 after growth)
+    const Vec3 from(u(rng) * L.x(), u(rng) * L.y(), u(rng) * L.z());
+    const std::uint32_t n = 1 + trial % 13;
+    std::vector<std::uint32_t> ids;
+    double max_abs = 0.0;  // of the centres inserted (S below)
+    for (std::uint32_t k = 0; k < n + 2; ++k) {
+      Vec3 c(u(rng) * L.x(), u(rng) * L.y(), u(rng) * L.z());
+      if (k % 3 == 0) {  // on the cut-off, +-1e-7, in a random direction (through the fold)
+        Vec3 dir(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5);
+        dir.normalize();
+        c = from + (reach + (u(rng) - 0.5) * 2e-7) * dir;
+        for (int a = 0; a < 2; ++a) c[a] -= L[a] * std::floor(c[a] / L[a]);
+      }
+      members.insert(0, 100 + k, c);
+      ids.push_back(100 + k);
+      max_abs = std::max(max_abs, c.cwiseAbs().maxCoeff());
+    }
+    members.remove(0, ids[trial % (n + 2)]);  // a hole, filled by the last member
+    members.remove(0, (members.end(0) - 1)->id);
+    ASSERT_EQ(members.size(0), n);
+    std::multiset<std::uint32_t> got;
+    members.for_each_within(0, from, period, reach, [&](std::uint32_t j) { got.insert(j); });
+    const double S = max_abs + from.cwiseAbs().maxCoeff() + reach + L.head<2>().maxCoeff();
+    std::set<std::uint32_t> all;
+    for (const CellMembers::Member* m = members.begin(0); m != members.end(0); ++m) {
+      const std::uint32_t j = m->id;
+      all.insert(j);
+      Vec3 d = m->centre() - from;
+      for (int a = 0; a < 3; ++a) d[a] = std::min(std::abs(d[a]), period[a] - std::abs(d[a]));
+      const double dist = d.norm();
+      if (std::abs(dist - reach) < 1e-5) ++near_cut;
+      if (dist <= reach) {
+        EXPECT_EQ(got.count(j), 1u) << "trial " << trial << " member " << j;
+      }
+      if (dist > reach + 1e-5 * S + 1e-9) {
+        EXPECT_EQ(got.count(j), 0u) << "trial " << trial;
+      }
+      EXPECT_LE(got.count(j), 1u);
+    }
+    for (std::uint32_t j : got) EXPECT_EQ(all.count(j), 1u) << "a removed member was reported";
+    reported += got.size();
+  }
+  EXPECT_GT(reported, 400u);
+  EXPECT_GT(near_cut, 200u);  // the cut-off was tried
 }
