@@ -84,7 +84,7 @@ TEST(CellMembers, WalkFindsTheMembersWithinReach) {
   std::size_t reported = 0, near_cut = 0;
   for (int trial = 0; trial < 400; ++trial) {
     CellMembers members;
-    members.init(1, 4);  // one cell; 13 members overflow it (capacity 16 after growth)
+    members.init(1, 1);  // one cell of capacity 10: the 11th insertion grows it
     const Vec3 from(u(rng) * L.x(), u(rng) * L.y(), u(rng) * L.z());
     const std::uint32_t n = 1 + trial % 13;
     std::vector<std::uint32_t> ids;
