@@ -87,7 +87,6 @@ TEST(CellMembers, WalkFindsTheMembersWithinReach) {
     members.init(1, 1);  // one cell of capacity 10: the 11th insertion grows it
     const Vec3 from(u(rng) * L.x(), u(rng) * L.y(), u(rng) * L.z());
     const std::uint32_t n = 1 + trial % 13;
-    std::vector<std::uint32_t> ids;
     double max_abs = 0.0;  // of the centres inserted (S below)
     for (std::uint32_t k = 0; k < n + 2; ++k) {
       Vec3 c(u(rng) * L.x(), u(rng) * L.y(), u(rng) * L.z());
@@ -97,11 +96,10 @@ TEST(CellMembers, WalkFindsTheMembersWithinReach) {
         c = from + (reach + (u(rng) - 0.5) * 2e-7) * dir;
         for (int a = 0; a < 2; ++a) c[a] -= L[a] * std::floor(c[a] / L[a]);
       }
-      members.insert(0, 100 + k, c);
-      ids.push_back(100 + k);
+      members.insert(0, 100 + k, c);  // ids 100, 101, ...
       max_abs = std::max(max_abs, c.cwiseAbs().maxCoeff());
     }
-    members.remove(0, ids[trial % (n + 2)]);  // a hole, filled by the last member
+    members.remove(0, 100 + trial % (n + 2));  // a hole, filled by the last member
     members.remove(0, (members.end(0) - 1)->id);
     ASSERT_EQ(members.size(0), n);
     std::multiset<std::uint32_t> got;
