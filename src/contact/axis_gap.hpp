@@ -423,6 +423,19 @@ struct SpinBound {
   double wmax = -1.0;  // < 0: a spherical top (w constant); else the largest angular speed
   double dwmax = 0.0;  // a bound of |dW/dt| (not spherical tops)
 };
+// Body A's rotation for a run of axis tests against many candidates (one prediction,
+// system/rigid_bodies.hpp): its matrix, formed once; a direction then turns into A's frame and
+// back by a matrix-vector product, half the arithmetic of a quaternion rotation. The tests take
+// A's rotation as either (to_body, to_lab); rounding differs, not the bound.
+struct RotationFrame {
+  Mat3 R;
+  explicit RotationFrame(const Quat& q) : R(q.toRotationMatrix()) {}
+};
+inline Vec3 to_body(const Quat& q, const Vec3& u) { return q.conjugate() * u; }
+inline Vec3 to_lab(const Quat& q, const Vec3& p) { return q * p; }
+inline Vec3 to_body(const RotationFrame& f, const Vec3& u) { return f.R.transpose() * u; }
+inline Vec3 to_lab(const RotationFrame& f, const Vec3& p) { return f.R * p; }
+
 // axis_clear_time: how long the gap along u is proven positive, a duration tau_c >= 0 from `now`
 // (kInf: for ever): g_u > margin on [now, now + tau_c) by the first-order line or, beyond its
 // end t1, by Q. The line stays above the margin up to t1 = (g1 - margin) / K_u; Q is concave,
@@ -430,8 +443,8 @@ struct SpinBound {
 // (and tau_c = r2), else tau_c = t1. A first-order t1 beyond `span` (the caller's window) is
 // returned as it is: the second order is not needed. clear_along_axis is tau_c > span. The
 // prediction loop (system/rigid_bodies.hpp, predict_contacts) orders its candidates by tau_c.
-template <SupportShape SA, SupportShape SB>
-double axis_clear_time(const SA& sa, const Quat& qa, const Vec3& wa, const SB& sb, const Quat& qb,
+template <SupportShape SA, SupportShape SB, class RA = Quat>
+double axis_clear_time(const SA& sa, const RA& qa, const Vec3& wa, const SB& sb, const Quat& qb,
                        const Vec3& wb, const Vec3& c, const Vec3& u, const Vec3& dv, double age,
                        double span, SpinBound spin_a = {}, SpinBound spin_b = {},
                        bool second_order = false) {
@@ -440,8 +453,9 @@ double axis_clear_time(const SA& sa, const Quat& qa, const Vec3& wa, const SB& s
   };
   const double sw_a = turn_speed(wa, spin_a), sw_b = turn_speed(wb, spin_b);
   const double turn_a = rotation_lever(sa) * sw_a, turn_b = rotation_lever(sb) * sw_b;
-  const Vec3 ma = qa.conjugate() * u, mb = qb.conjugate() * Vec3(-u);
-  const double g_old = u.dot(c) - sa.support(ma) - sb.support(mb);  // B as it was at t_B
+  const Vec3 ma = to_body(qa, u), mb = to_body(qb, Vec3(-u));
+  const double ha = sa.support(ma), hb = sb.support(mb);
+  const double g_old = u.dot(c) - ha - hb;  // B as it was at t_B
   const double g = g_old - turn_b * age;
   const double Ku = std::abs(u.dot(dv)) + turn_a + turn_b;
   const double margin = 1e-10 * (sa.bounding_radius() + sb.bounding_radius());
@@ -451,7 +465,8 @@ double axis_clear_time(const SA& sa, const Quat& qa, const Vec3& wa, const SB& s
   if constexpr (AxisGap<SA, SB>::kMayCurve) {
     // Turn rates 0 (spheres: rotation levers 0): the first-order line is as good; no second order.
     if (!second_order || !(turn_a + turn_b > 0.0) || !AxisGap<SA, SB>::curved(sa, sb)) return t1;
-    const Vec3 pa = qa * sa.support_point(ma), pb = qb * sb.support_point(mb);
+    const Vec3 pa = to_lab(qa, support_point_given(sa, ma, ha));
+    const Vec3 pb = to_lab(qb, support_point_given(sb, mb, hb));
     const double ra = wa.cross(pa).dot(u), rb = -wb.cross(pb).dot(u);
     auto curvature = [](const auto& shape, const Vec3& w, SpinBound spin, double sw) {
       const double mdd = spin.wmax < 0.0 ? w.norm() * sw : sw * sw + spin.dwmax;  // |m''|
@@ -478,8 +493,8 @@ bool clear_along_axis(const SA& sa, const Quat& qa, const Vec3& wa, const SB& sb
          axis_clear_time(sa, qa, wa, sb, qb, wb, c, u, dv, age, span, spin_a, spin_b, second_order) >
              span;
 }
-template <SupportShape SA, SupportShape SB>
-double centres_clear_time(const SA& sa, const Quat& qa, const Vec3& wa, const SB& sb,
+template <SupportShape SA, SupportShape SB, class RA = Quat>
+double centres_clear_time(const SA& sa, const RA& qa, const Vec3& wa, const SB& sb,
                           const Quat& qb, const Vec3& wb, const Vec3& c, const Vec3& dv,
                           double age, double span, SpinBound spin_a = {},
                           SpinBound spin_b = {}, bool second_order = false) {

@@ -25,13 +25,16 @@ struct Ellipsoid {
   static constexpr bool kBoundedCurvature = true;    // shapes/shape.hpp
   // The semi-axes: set them through the constructor (the squares and inverse squares the
   // solvers use at every evaluation are kept beside them; three divisions per f, grad or
-  // Hessian otherwise). Read-only in practice: a shape is rebuilt, never edited.
+  // Hessian otherwise; and the largest and smallest semi-axes, and the largest radius of
+  // curvature, which the prediction's axis pre-filter asks for per candidate: a division each
+  // time otherwise). Read-only in practice: a shape is rebuilt, never edited.
   double a = 1.0, b = 1.0, c = 1.0;
 
   Ellipsoid() = default;
   Ellipsoid(double a_, double b_, double c_)
       : a(a_), b(b_), c(c_), sq_(a_ * a_, b_ * b_, c_ * c_),
-        inv_sq_(1.0 / (a_ * a_), 1.0 / (b_ * b_), 1.0 / (c_ * c_)) {}
+        inv_sq_(1.0 / (a_ * a_), 1.0 / (b_ * b_), 1.0 / (c_ * c_)),
+        max_(std::max({a_, b_, c_})), min_(std::min({a_, b_, c_})), rho_max_(max_ * max_ / min_) {}
 
   const Vec3& inv_sq() const { return inv_sq_; }
   const Vec3& sq() const { return sq_; }
@@ -41,26 +44,24 @@ struct Ellipsoid {
   Mat3 hessian(const Vec3& /*x*/) const { return Mat3(2.0 * inv_sq().asDiagonal()); }
 
   double volume() const { return 4.0 / 3.0 * kPi * a * b * c; }
-  double bounding_radius() const { return std::max({a, b, c}); }
-  double inscribed_radius() const { return std::min({a, b, c}); }
+  double bounding_radius() const { return max_; }
+  double inscribed_radius() const { return min_; }
   // max |p x m| over unit m (shapes/shape.hpp, rotation_lever): with weights w_i = m_i^2 and
   // X = a_i^2 with probability w_i, |p x m|^2 = |p|^2 - h^2 = E[X^2] / E[X] - E[X] = Var X / E X,
   // whose largest value for X in [a_min^2, a_max^2] is (a_max - a_min)^2 (attained by two
   // values at the ends of the range).
-  double rotation_lever() const { return std::max({a, b, c}) - std::min({a, b, c}); }
+  double rotation_lever() const { return max_ - min_; }
   Vec3 half_extents() const { return Vec3(a, b, c); }
   Vec3 ray_surface(const Vec3& u) const {
     return u / std::sqrt(u.cwiseProduct(u).dot(inv_sq()));
   }
 
   double support(const Vec3& n) const { return std::sqrt(n.cwiseProduct(n).dot(sq())); }
-  Vec3 support_point(const Vec3& n) const { return n.cwiseProduct(sq()) / support(n); }
+  Vec3 support_point(const Vec3& n) const { return support_point(n, support(n)); }
+  Vec3 support_point(const Vec3& n, double h) const { return n.cwiseProduct(sq()) / h; }  // h = support(n)
   // Largest principal radius of curvature of the surface, max(a,b,c)^2 / min(a,b,c): it bounds
   // the support Hessian, |m^T (d^2 h) m| <= rho_max |m|^2 for unit n (used by the contact solver).
-  double max_curvature_radius() const {
-    const double mx = std::max({a, b, c}), mn = std::min({a, b, c});
-    return mx * mx / mn;
-  }
+  double max_curvature_radius() const { return rho_max_; }
   Mat3 support_hessian(const Vec3& n) const {
     const double h = support(n);
     const Vec3 mn = n.cwiseProduct(sq());
@@ -76,6 +77,7 @@ struct Ellipsoid {
 
  private:
   Vec3 sq_ = Vec3::Ones(), inv_sq_ = Vec3::Ones();
+  double max_ = 1.0, min_ = 1.0, rho_max_ = 1.0;
 };
 
 struct Sphere {

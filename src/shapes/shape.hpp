@@ -55,6 +55,19 @@ concept CentrallySymmetric = requires { requires S::kCentrallySymmetric; };
 template <class S>
 concept SupportIsPointDot = requires { requires S::kSupportIsPointDot; };
 
+// The support point p(n) when the support value h = support(n) is at hand: shapes that form the
+// point from the value declare support_point(n, h) (ellipsoids: M n / h, the same bits as
+// support_point(n) without its square root); others solve again.
+template <SupportShape S>
+Vec3 support_point_given(const S& s, const Vec3& n, double h) {
+  if constexpr (requires { { s.support_point(n, h) } -> std::convertible_to<Vec3>; }) {
+    return s.support_point(n, h);
+  } else {
+    (void)h;
+    return s.support_point(n);
+  }
+}
+
 // Shapes whose max_curvature_radius() is finite for every valid instance (ellipsoids, spheres)
 // declare `static constexpr bool kBoundedCurvature = true`: the contact-time solver then
 // compiles only its second-order axis steps for their pairs, not the flat-face ones

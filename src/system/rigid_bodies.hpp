@@ -214,18 +214,24 @@ inline SpinBound spin_bound(const State& s, std::uint32_t j) {
 // - with the second order along the memo's axis, the line of centres after it (first order;
 //   it came second since the sixth part) clears too few to pay for itself: -2.7 % at X0 = 2
 //   without it, no change at X0 = 10.
+// fa: body i's rotation matrix, RotationFrame(a.q) (contact/axis_gap.hpp), formed once per
+// prediction; the tests turn directions by products with it instead of quaternion rotations.
+// Measured with the shape constants kept in Ellipsoid and support_point_given (callgrind, N =
+// 1083, phi = 0.4, docs/benchmarks/README.md, "Session of 2026-12-02, second part"): -3.2 %
+// instructions a collision at X0 = 10, -2.6 % at X0 = 1.
 template <class SA, class SB>
 double memo_or_centres_clear_time(const SA& A, const SB& B, const State& s, std::uint32_t i,
-                                  const BodyState& a, std::uint32_t j, const Vec3& c, double now,
-                                  double horizon, const AxisMemo& memo) {
+                                  const BodyState& a, const RotationFrame& fa, std::uint32_t j,
+                                  const Vec3& c, double now, double horizon,
+                                  const AxisMemo& memo) {
   const Vec3 dv = s.v[j] - a.v;
   const SpinBound wa = spin_bound(a), wb = spin_bound(s, j);
   const double age = now - s.t[j], span = horizon - now;
   Vec3 u;
   if (memo.find_either(i, j, u))
-    return axis_clear_time(A, a.q, a.w, B, s.q[j], s.w[j], c, Vec3(u.normalized()), dv, age, span,
+    return axis_clear_time(A, fa, a.w, B, s.q[j], s.w[j], c, Vec3(u.normalized()), dv, age, span,
                            wa, wb, /*second_order=*/true);
-  return centres_clear_time(A, a.q, a.w, B, s.q[j], s.w[j], c, dv, age, span, wa, wb,
+  return centres_clear_time(A, fa, a.w, B, s.q[j], s.w[j], c, dv, age, span, wa, wb,
                             /*second_order=*/true);
 }
 
@@ -437,6 +443,7 @@ struct RigidBodies {
                      double* out) const {
     const ScaleLaw sl{law.scale_at(now), law.rate_at(now)};        // {1, 0} without growth
     const double law_end = now < law.t_stop ? law.t_stop : kInf;  // the law changes there
+    const RotationFrame fa(s.q[i]);  // body i at `now`: the axis tests' frame (centre_line_clear)
     predict_contacts(
         s, box, i, js, shifts, n, now, horizons, out, law_end, trim_horizons, stats,
         [&](const BodyState& a, const BodyState& b, std::uint32_t j, double horizon, const double* window) {
@@ -457,7 +464,7 @@ struct RigidBodies {
         },
         sl.active() ? 0.0 : window_radius(),
         [&](const BodyState& a, std::uint32_t j, const Vec3& c, double horizon) {
-          return centre_line_clear(s, i, a, j, c, now, horizon);
+          return centre_line_clear(s, i, a, fa, j, c, now, horizon);
         },
         order_by_bound);
   }
@@ -467,10 +474,11 @@ struct RigidBodies {
   // memo), or, for a pair not in it, along their line of centres (memo_or_centres_clear_time; for
   // tops that are not spherical with their largest angular speeds, from the free rotation the
   // solver uses); 0 when off (centre_line_test, the slow twin).
-  double centre_line_clear(const State& s, std::uint32_t i, const BodyState& a, std::uint32_t j,
-                           const Vec3& c, double now, double horizon) const {
+  double centre_line_clear(const State& s, std::uint32_t i, const BodyState& a,
+                           const RotationFrame& fa, std::uint32_t j, const Vec3& c, double now,
+                           double horizon) const {
     return centre_line_test
-               ? memo_or_centres_clear_time(shape, shape, s, i, a, j, c, now, horizon, memo)
+               ? memo_or_centres_clear_time(shape, shape, s, i, a, fa, j, c, now, horizon, memo)
                : 0.0;
   }
   // The radius of contact_time's bounding-sphere test for two bodies of this shape at scale 1

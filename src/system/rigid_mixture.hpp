@@ -103,6 +103,7 @@ struct RigidMixture {
     const AnyShape sa = body_shape(s, i);
     const ScaleLaw sl{law.scale_at(now), law.rate_at(now)};
     const double law_end = now < law.t_stop ? law.t_stop : kInf;  // the law changes there
+    const RotationFrame fa(s.q[i]);  // body i at `now`: the axis tests' frame (centre_line_clear)
     predict_contacts(
         s, box, i, js, shifts, n, now, horizons, out, law_end, trim_horizons, stats,
         [&](const BodyState& a, const BodyState& b, std::uint32_t j, double horizon,
@@ -132,7 +133,7 @@ struct RigidMixture {
           return off ? 0.0 : window_radius(Li, s, j);
         },
         [&](const BodyState& a, std::uint32_t j, const Vec3& c, double horizon) {
-          return centre_line_clear(s, i, sa, a, j, c, now, horizon);
+          return centre_line_clear(s, i, sa, a, fa, j, c, now, horizon);
         },
         order_by_bound);
   }
@@ -143,7 +144,8 @@ struct RigidMixture {
   // with the shapes the solver gets. A resized superquadric is skipped (0: its construction
   // searches its farthest point; the solver builds it anyway if needed).
   double centre_line_clear(const State& s, std::uint32_t i, const AnyShape& sa, const BodyState& a,
-                           std::uint32_t j, const Vec3& c, double now, double horizon) const {
+                           const RotationFrame& fa, std::uint32_t j, const Vec3& c, double now,
+                           double horizon) const {
     if (!centre_line_test) return 0.0;
     const AnyShape& base = shape[s.species[j]];
     AnyShape scaled;
@@ -155,7 +157,7 @@ struct RigidMixture {
     }
     return std::visit(
         [&](const auto& A, const auto& B) {
-          return memo_or_centres_clear_time(A, B, s, i, a, j, c, now, horizon, memo);
+          return memo_or_centres_clear_time(A, B, s, i, a, fa, j, c, now, horizon, memo);
         },
         sa, *sb);
   }

@@ -211,7 +211,7 @@ void check_second_order_clear(std::uint64_t seed, bool tops) {
   Rng r(seed);
   const int n = scaled_count(2000, 0.1);
   int first = 0, second = 0, clear_times = 0;
-  double worst = -kInf;
+  double worst = -kInf, frame_worst = 0.0;
   for (int k = 0; k < n; ++k) {
     const ClearCase cc = clear_case(r, tops);
     const auto& [p, ma, mb, age, span, c, wa, qa] = cc;
@@ -239,6 +239,16 @@ void check_second_order_clear(std::uint64_t seed, bool tops) {
                                       spin(ma), spin(mb), true);
     EXPECT_EQ(quad, tc > span) << k;
     clear_times += tc > 0.0;
+    // A's rotation as a matrix (RotationFrame: the prediction loop's form) gives the same time
+    // to rounding
+    const double tf = axis_clear_time(p.a, RotationFrame(qa), wa, p.b, p.sb.q, p.sb.w, c, u, dv,
+                                      age, kInf, spin(ma), spin(mb), true);
+    if (std::isinf(tc)) {
+      EXPECT_EQ(tf, tc) << k;
+    } else {
+      EXPECT_NEAR(tf, tc, 1e-9 * (span + tc)) << k;
+    }
+    frame_worst = std::max(frame_worst, std::isinf(tc) ? 0.0 : std::abs(tf - tc) / (span + tc));
     for (int m = 0; m < 20 && tc > 0.0; ++m) {
       const double t = age + std::min(tc, 2.5 * span) * m / 20.0;
       const Vec3 ct = mb.position(t) - ma.position(t);
@@ -272,8 +282,8 @@ void check_second_order_clear(std::uint64_t seed, bool tops) {
     }
   }
   std::printf("  %d pairs%s: %d clear to first order, %d with the second, %d with a clear time "
-              "> 0, max (Q - g_u) %.2e\n", n, tops ? " (asymmetric tops)" : "", first, second,
-              clear_times, worst);
+              "> 0, max (Q - g_u) %.2e, matrix vs quaternion %.1e\n", n,
+              tops ? " (asymmetric tops)" : "", first, second, clear_times, worst, frame_worst);
   EXPECT_GT(clear_times, second);
   EXPECT_LE(worst, 1e-8);  // central differences: rates to ~1e-10
   EXPECT_GT(second, first + n / 50);
@@ -283,6 +293,20 @@ void check_second_order_clear(std::uint64_t seed, bool tops) {
 TEST(AxisGap, SecondOrderClearIsBelowTheGapAlongItsAxis) { check_second_order_clear(97, false); }
 TEST(AxisGap, SecondOrderClearIsBelowTheGapAlongItsAxisForAsymmetricTops) {
   check_second_order_clear(101, true);
+}
+
+// support_point_given (shapes/shape.hpp): the support point from the value at hand is the one
+// support_point computes, bit for bit (ellipsoids form it from the value; superquadrics solve
+// again); the second-order clear test uses it.
+TEST(AxisGap, SupportPointGivenItsValueIsTheSupportPoint) {
+  Rng r(113);
+  const Superquadric sq(1.0, 0.7, 0.4, 2.0, 4.0, 8.0);
+  for (int k = 0; k < 200; ++k) {
+    const Ellipsoid e = r.ellipsoid(10.0);
+    const Vec3 m = r.unit();
+    EXPECT_EQ(support_point_given(e, m, e.support(m)), e.support_point(m)) << k;
+    EXPECT_EQ(support_point_given(sq, m, sq.support(m)), sq.support_point(m)) << k;
+  }
 }
 
 TEST(AxisGap, SeparatingAxisSearchApproachesTheDistance) {

@@ -315,7 +315,7 @@ void check_centre_line_test(const Vec3& inertia) {
         predict_contacts(s, box, i, js.data(), nullptr, js.size(), now, horizons.data(), out.data(),
                          kInf, true, stats, solve, fail, R,
                          [&](const BodyState& a, std::uint32_t j, const Vec3& c, double horizon) {
-                           return m.centre_line_clear(s, i, a, j, c, now, horizon);
+                           return m.centre_line_clear(s, i, a, RotationFrame(a.q), j, c, now, horizon);
                          });
       });
   std::printf("  %llu predictions, %ld solved after the bounding spheres, %ld after the line of "
