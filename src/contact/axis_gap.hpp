@@ -410,10 +410,26 @@ Vec3 separating_axis_at(const SA& sa, const Quat& rot_a, const SB& sb, const Qua
 //                                 - [h_B(t_B) + r_B (age + tau) + M_B (age + tau)^2 / 2],
 // r_A = (w_A x p_A).u at now, r_B = -(w_B x p_B).u at t_B. Q is a concave parabola in tau.
 //
+// Affine (second_order = true, pairs with an unbounded radius of curvature: superquadrics with
+// an exponent > 2, whose flat faces leave Q without its M). AxisGap's affine bound (below),
+// written for A from `now` and for B from t_B: with m' the exact rate of a body-frame direction
+// at one instant (m_A = R_A^T u: m_A' = R_A^T (u x w_A); m_B = -R_B^T u: m_B' = R_B^T (w_B x u)),
+// m(t + s) = m + s m' + r, |r| <= s^2 |m''|max / 2, and h sublinear (h(x + r) <= h(x) + L |r|),
+//     g_u(now + tau) >= F(tau) := u.c + u.dv tau - h_A(m_A + tau m_A') - L_A mdd_A tau^2 / 2
+//                                 - h_B(m_B + (age + tau) m_B') - L_B mdd_B (age + tau)^2 / 2,
+// mdd the |m''| bounds of the second order. F is concave (a linear function less convex
+// functions of affine arguments), so F > margin at tau = 0 and at tau = span holds it above
+// the margin over the window, and otherwise the chord between them stays below F: its zero
+// bounds the first zero of F from below. The end at tau = 0 is taken below F(0) without a
+// support function, h_B(m_B + age m_B') <= h_B(m_B) + age L_B |m_B'| (a lower end point only
+// lowers the chord), so the test costs one support function per body (of a non-unit
+// direction) beyond the first order's.
+//
 // Both lines bound g_u over the whole window, so g_u stays positive where either does: the
 // first-order line up to t1 = g1 / K_u, Q beyond it (a concave Q is above a level on [t1, span]
-// if it is at both ends). True means g_u, hence the distance, stays positive over the window:
-// no contact there (the answer the contact-time solver would give; false: not decided). The
+// if it is at both ends; F likewise on [0, span]). True means g_u, hence the distance, stays
+// positive over the window: no contact there (the answer the contact-time solver would give;
+// false: not decided). The
 // margin 1e-10 (L_A + L_B) covers rounding. The first-order test along the line of centres
 // alone rules out 42 % of the candidates that pass the bounding spheres in an ellipsoid fluid
 // (phi = 0.5, X0 = 2, NNL, spherical tops); the second order along the pair's last axis (the
@@ -440,8 +456,11 @@ inline Vec3 to_lab(const RotationFrame& f, const Vec3& p) { return f.R * p; }
 // (kInf: for ever): g_u > margin on [now, now + tau_c) by the first-order line or, beyond its
 // end t1, by Q. The line stays above the margin up to t1 = (g1 - margin) / K_u; Q is concave,
 // so where Q(t1) > margin it stays above the margin up to its larger root r2 of Q = margin
-// (and tau_c = r2), else tau_c = t1. A first-order t1 beyond `span` (the caller's window) is
-// returned as it is: the second order is not needed. clear_along_axis is tau_c > span. The
+// (and tau_c = r2), else tau_c = t1. Pairs without a bounded curvature take the affine F instead
+// of Q (a finite span only): F > margin at both ends gives a time just past span (the window
+// is covered; F says nothing beyond it), else the larger of t1 and the chord's zero. A
+// first-order t1 beyond `span` (the caller's window) is returned as it is: the second order is
+// not needed. clear_along_axis is tau_c > span. The
 // prediction loop (system/rigid_bodies.hpp, predict_contacts) orders its candidates by tau_c.
 template <SupportShape SA, SupportShape SB, class RA = Quat>
 double axis_clear_time(const SA& sa, const RA& qa, const Vec3& wa, const SB& sb, const Quat& qb,
@@ -462,15 +481,37 @@ double axis_clear_time(const SA& sa, const RA& qa, const Vec3& wa, const SB& sb,
   // the first-order line stays above the margin up to t1
   const double t1 = !(g > margin) ? 0.0 : Ku > 0.0 ? (g - margin) / Ku : kInf;
   if (t1 > span) return t1;  // the window is covered: no second order needed
+  // Turn rates 0 (spheres: rotation levers 0): the first-order line is as good; no second order.
+  if (!second_order || !(turn_a + turn_b > 0.0)) return t1;
+  auto turn_acceleration = [](const Vec3& w, SpinBound spin, double sw) {  // a bound of |m''|
+    return spin.wmax < 0.0 ? w.norm() * sw : sw * sw + spin.dwmax;
+  };
+  if (!AxisGap<SA, SB>::curved(sa, sb)) {  // flat faces: the affine bound F
+    if (!(span < kInf)) return t1;
+    const double Qa = sa.bounding_radius() * turn_acceleration(wa, spin_a, sw_a);
+    const double Qb = sb.bounding_radius() * turn_acceleration(wb, spin_b, sw_b);
+    const Vec3 da = to_body(qa, u.cross(wa)), db = to_body(qb, wb.cross(u));  // m_A', m_B'
+    const double uc = u.dot(c), udv = u.dot(dv);
+    auto F = [&](double tau) {  // F - margin
+      const double sb_tau = age + tau;
+      return uc + udv * tau - sa.support(ma + tau * da) - sb.support(mb + sb_tau * db) -
+             0.5 * (Qa * tau * tau + Qb * sb_tau * sb_tau) - margin;
+    };
+    // F(0) from below without a support function: h_B(m_B + age m_B') <= h_B(m_B) + age L_B
+    // |m_B'| (sublinear); a lower end point only lowers the chord
+    const double f0 = g_old - age * (sb.bounding_radius() * db.norm() + 0.5 * Qb * age) - margin;
+    if (!(f0 > 0.0)) return t1;
+    const double fs = F(span);
+    if (fs > 0.0) return std::max(t1, std::nextafter(span, kInf));
+    return std::max(t1, span * (f0 / (f0 - fs)));
+  }
   if constexpr (AxisGap<SA, SB>::kMayCurve) {
-    // Turn rates 0 (spheres: rotation levers 0): the first-order line is as good; no second order.
-    if (!second_order || !(turn_a + turn_b > 0.0) || !AxisGap<SA, SB>::curved(sa, sb)) return t1;
     const Vec3 pa = to_lab(qa, support_point_given(sa, ma, ha));
     const Vec3 pb = to_lab(qb, support_point_given(sb, mb, hb));
     const double ra = wa.cross(pa).dot(u), rb = -wb.cross(pb).dot(u);
-    auto curvature = [](const auto& shape, const Vec3& w, SpinBound spin, double sw) {
-      const double mdd = spin.wmax < 0.0 ? w.norm() * sw : sw * sw + spin.dwmax;  // |m''|
-      return shape.max_curvature_radius() * sw * sw + shape.bounding_radius() * mdd;
+    auto curvature = [&](const auto& shape, const Vec3& w, SpinBound spin, double sw) {
+      return shape.max_curvature_radius() * sw * sw +
+             shape.bounding_radius() * turn_acceleration(w, spin, sw);
     };
     const double Ma = curvature(sa, wa, spin_a, sw_a), Mb = curvature(sb, wb, spin_b, sw_b);
     const double q0 = g_old - age * (rb + 0.5 * Mb * age) - margin;  // Q - margin
