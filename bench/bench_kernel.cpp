@@ -130,6 +130,23 @@ void support_bench(benchmark::State& state, const Superquadric& s) {
   }
 }
 
+// The same with each direction depending on the previous point (d (1 + 0 x_0): IEEE keeps the
+// product), so the calls do not overlap: the latency of one support point, as in the engine's
+// searches, where each step's direction comes from the last step's points.
+void support_chain_bench(benchmark::State& state, const Superquadric& s) {
+  Gen g;
+  std::vector<Vec3> dirs(4096);
+  for (Vec3& d : dirs) d = g.unit();
+  size_t i = 0;
+  double carry = 0.0;
+  for (auto _ : state) {
+    const Vec3 x = s.support_point(dirs[i] * (1.0 + carry));
+    carry = 0.0 * x[0];
+    benchmark::DoNotOptimize(carry);
+    i = (i + 1) & 4095;
+  }
+}
+
 const Sphere kSphere{0.5};
 const Ellipsoid kProlate{1.0, 0.5, 0.5};  // X0 = 2 (symmetry axis along x)
 const Ellipsoid kOblate{0.25, 0.5, 0.5};  // X0 = 0.5
@@ -154,6 +171,12 @@ void BM_SupportSuperquadricP2(benchmark::State& s) { support_bench(s, {1.0, 0.5,
 void BM_SupportSuperquadricP8(benchmark::State& s) { support_bench(s, {1.0, 0.5, 0.5, 2, 2, 8}); }
 void BM_SupportSuperquadricP20(benchmark::State& s) { support_bench(s, {1.0, 0.5, 0.5, 2, 2, 20}); }
 void BM_SupportSuperquadric338(benchmark::State& s) { support_bench(s, {1.0, 0.5, 0.5, 3, 3, 8}); }
+void BM_SupportChainSuperquadricP2(benchmark::State& s) {
+  support_chain_bench(s, {1.0, 0.5, 0.5, 2, 2, 2});
+}
+void BM_SupportChainSuperquadricP8(benchmark::State& s) {
+  support_chain_bench(s, {1.0, 0.5, 0.5, 2, 2, 8});
+}
 
 BENCHMARK(BM_DistanceSphereAnalytic);
 BENCHMARK(BM_DistanceSphereGenericCold);
@@ -171,6 +194,8 @@ BENCHMARK(BM_SupportSuperquadricP2);
 BENCHMARK(BM_SupportSuperquadricP8);
 BENCHMARK(BM_SupportSuperquadricP20);
 BENCHMARK(BM_SupportSuperquadric338);
+BENCHMARK(BM_SupportChainSuperquadricP2);
+BENCHMARK(BM_SupportChainSuperquadricP8);
 
 }  // namespace
 

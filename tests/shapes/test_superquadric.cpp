@@ -280,7 +280,7 @@ TEST(Superquadric, SupportHessianFormsMatchTheSupportHessian) {
 // near its plane (K up to 1e24, and d_p = 0, which takes the general solver).
 TEST(Superquadric, FlatAxisSupportPointMatchesBisection) {
   Rng r(109);
-  double worst_x = 0, worst_f = 0, worst_par = 0;
+  double worst_x = 0, worst_f = 0, worst_par = 0, worst_h = 0;
   for (int p = 3; p <= 64; ++p) {
     for (int k = 0; k < 3; ++k) {
       Vec3 ax(r.log_uni(0.2, 2.0), r.log_uni(0.2, 2.0), r.log_uni(0.2, 2.0)), e(2, 2, 2);
@@ -303,11 +303,20 @@ TEST(Superquadric, FlatAxisSupportPointMatchesBisection) {
         const double par = s.grad(x).normalized().dot(d.normalized());
         worst_par = std::max(worst_par, 1 - par);
         EXPECT_GT(par, 1.0 - 1e-13) << p << " " << k << " " << j;
+        // the solver's multiplier lambda (from the root: 1 / x^(p-1) = x + K x^(p-1)) scales
+        // the support Hessian; the forms take theirs from x (lambda = d.x / sum e_i t_i^e_i)
+        const Vec3 u = r.unit(), v = r.unit();
+        const Mat3 H = s.support_hessian(d);
+        const Vec3 want(u.dot(H * u), v.dot(H * u), v.dot(H * v));
+        const double herr = (s.support_hessian_forms(d, x, u, v) - want).norm() / H.norm();
+        worst_h = std::max(worst_h, herr);
+        EXPECT_LE(herr, 1e-12) << p << " " << k << " " << j;
       }
     }
   }
   std::printf("  (2, 2, p) support point: max |x - bisection| %.2e L, |F(x)| %.2e, "
-              "1 - cos(normal, d) %.2e\n", worst_x, worst_f, worst_par);
+              "1 - cos(normal, d) %.2e, Hessian forms vs matrix %.2e\n", worst_x, worst_f,
+              worst_par, worst_h);
 }
 
 // The (2, 2, p) solver's start (sq_detail::FlatStartTable) against a long-double bisection of
