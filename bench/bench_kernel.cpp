@@ -119,10 +119,16 @@ void contact_bench(benchmark::State& state, const S& s) {
   state.counters["hit_fraction"] = double(hits) / calls;
 }
 
-void support_bench(benchmark::State& state, const Superquadric& s) {
+// 4096 unit directions (the support benchmarks' inputs)
+std::vector<Vec3> support_directions() {
   Gen g;
   std::vector<Vec3> dirs(4096);
   for (Vec3& d : dirs) d = g.unit();
+  return dirs;
+}
+
+void support_bench(benchmark::State& state, const Superquadric& s) {
+  const std::vector<Vec3> dirs = support_directions();
   size_t i = 0;
   for (auto _ : state) {
     benchmark::DoNotOptimize(s.support_point(dirs[i]));
@@ -134,9 +140,7 @@ void support_bench(benchmark::State& state, const Superquadric& s) {
 // product), so the calls do not overlap: the latency of one support point, as in the engine's
 // searches, where each step's direction comes from the last step's points.
 void support_chain_bench(benchmark::State& state, const Superquadric& s) {
-  Gen g;
-  std::vector<Vec3> dirs(4096);
-  for (Vec3& d : dirs) d = g.unit();
+  const std::vector<Vec3> dirs = support_directions();
   size_t i = 0;
   double carry = 0.0;
   for (auto _ : state) {

@@ -317,7 +317,7 @@ TEST(AxisGap, SecondOrderClearIsBelowTheGapAlongItsAxisForAsymmetricTops) {
 // the same time to rounding.
 void check_affine_clear(std::uint64_t seed, bool tops) {
   Rng r(seed);
-  // all 1000 pairs in the sanitizer build too (~3 s): the chord path is rare (about 1 %)
+  // all 1000 pairs in the sanitizer build too (~0.5 s): the chord path is rare (about 1 %)
   const int n = 1000;
   int first = 0, affine = 0, partial = 0, judged = 0;
   double worst = -kInf, worst_mdd = 0.0, frame_worst = 0.0;
