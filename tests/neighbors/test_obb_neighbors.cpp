@@ -297,7 +297,9 @@ TEST(ObbNeighbors, LedBoxesGiveTheSameCollisionsAsCentredBoxes) {
       }
     }
     std::printf("[ NNL ] first %zu of %zu collisions identical to centred boxes\n", same, n);
-    if (parted_at_grazing) EXPECT_GE(same, n / 2);  // most of the run compared
+    if (parted_at_grazing) {
+      EXPECT_GE(same, n / 2);  // most of the run compared
+    }
     const auto rebuilds = [](const auto& sim) { return sim.event_counts()[int(EventType::Rebuild)]; };
     std::printf("[ NNL ] rebuilds %lu led (%lu of them led the box), %lu centred\n",
                 (unsigned long)rebuilds(led), (unsigned long)led.neighbors().leads(),
@@ -305,7 +307,9 @@ TEST(ObbNeighbors, LedBoxesGiveTheSameCollisionsAsCentredBoxes) {
     EXPECT_EQ(centred.neighbors().leads(), 0u);
     EXPECT_GT(led.neighbors().leads(), rebuilds(led) / 4);
     EXPECT_LT(rebuilds(led), rebuilds(centred));
-    if (!parted_at_grazing) expect_same_energy(led, centred);
+    if (!parted_at_grazing) {
+      expect_same_energy(led, centred);
+    }
     // every body inside its (led or centred) box, and the run overlap-free and conservative
     EXPECT_GE(min_clearance(led.neighbors(), led.state(), led.model().shape, led.now()), 0.0);
     expect_lists_match_brute_force(led.neighbors(), led.box(), led.state().size());
