@@ -23,19 +23,21 @@
 // side (contact times are symmetric), and j's next collision or rebuild re-predicts j in full.
 //
 // Boxes led along the flight. Nothing above needs B_i centred on the body: only that the body is
-// inside B_i from the rebuild to its escape event. So a body that ran free since its last
-// rebuild (no collision turned its velocity: the vector from it to its box centre is parallel
-// to v) gets the box of the pose free flight gives it after a lead tau (centre r + v tau along
-// the periodic axes, axes of its orientation then), provided it stands at least margin + 0.1
-// (shell - margin) inside every face of that box now (clearance: its exact support values). It
-// then crosses the box instead of leaving it from the middle: in a dilute fluid up to twice the
-// time between rebuilds. tau: a trial of one shell's travel, shell / |v|, then the secant of the
-// clearance (shell at tau = 0, falling about linearly) to 0.2 (shell - margin), halved up to
-// three times if that is short; else the centred box. After a collision the box is centred:
-// a body that bounces back would find a led box's rear face near (in dense fluids, where the
-// rebuilds follow collisions, the lead measured +1.5 % per collision; docs/benchmarks). The
-// centre is wrapped into [0, L) on its own, so the escape search takes the box's image nearest
-// to the body (box_near). set_lead(false): every box centred, the paper's (the slow twin).
+// inside B_i from the rebuild to its escape event. So at a rebuild the body gets the box of the
+// pose free flight gives it after a lead tau (centre r + v tau along the periodic axes, axes of
+// its orientation then), provided it stands at least margin + 0.1 (shell - margin) inside every
+// face of that box now (clearance: its exact support values). It then crosses the box instead
+// of leaving it from the middle: in a dilute fluid up to twice the time between rebuilds. tau:
+// a trial of one shell's travel, shell / |v|, then the secant of the clearance (shell at tau =
+// 0, falling about linearly) to the aim, halved up to three times if that is short; else the
+// centred box. The aim is 0.2 (shell - margin) of room behind the body when it ran free since
+// its last rebuild (the vector from it to its box centre is parallel to v: no collision turned
+// v), and 0.6 after a collision: a body that bounces back in a cage would find a rear face at
+// 0.2 near (in the dense e1, aim 0.2 after collisions measured +2 % per collision, 0.6 none;
+// docs/benchmarks). Decided from the state and the boxes alone, so a restored checkpoint
+// decides the same way. The centre is wrapped into [0, L) on its own, so the escape search
+// takes the box's image nearest to the body (box_near). set_lead(false): every box centred,
+// the paper's (the slow twin).
 //
 // Escape search: the box is shrunk by margin = min(0.01 inscribed radius, shell / 4) and the
 // grazing step is eps = margin (paper: epsilon_d^nnl ~ 1e-2 b), so a grazing exit that the
@@ -359,51 +361,51 @@ class ObbNeighbors {
       // ran free: the body moved along v since its box was built (led or centred), so the
       // body-to-centre vector is parallel to v; a collision in between turns v
       const Vec3 d = box_near(i, s.r[i]).centre - s.r[i];
-      if (d.cross(v).squaredNorm() <= 1e-18 * d.squaredNorm() * v.squaredNorm()) {
-        const BodyState b = s.body(i);
-        double margin;
-        if constexpr (kMixture) margin = body_margin(kinds_[s.species[i]].inscribed * s.scale[i]);
-        else margin = margin_;
-        const double room = shell_ - margin;
-        const Motion m(b);
-        Obb cand;
-        cand.half = half;
-        Quat q;
-        auto clearance_after = [&](double tau) {
-          Vec3 w;
-          m.pose(tau, q, w);
-          cand.centre = b.r;
-          for (int k = 0; k < 3; ++k)
-            if (box.periodic[k]) cand.centre[k] += b.v[k] * tau;
-          cand.axes = q.toRotationMatrix();
-          if constexpr (kMixture) {
-            const Kind& kind = kinds_[s.species[i]];
-            const double sc = s.scale[i];
-            const AnyShape shape = sc == 1.0 ? kind.shape : resized(kind.shape, sc);
-            return std::visit([&](const auto& x) { return clearance(x, b.r, b.q, cand); }, shape);
-          } else {
-            return clearance(shape_, b.r, b.q, cand);
-          }
-        };
-        // a trial lead of one shell's travel, then the secant to the aim: the clearance falls
-        // from shell (no lead) about linearly with tau
-        double tau = shell_ / std::sqrt(v.squaredNorm());
-        double c = clearance_after(tau);
-        if (c < shell_) {
-          tau *= (shell_ - (margin + kLeadAim * room)) / (shell_ - c);
-          c = clearance_after(tau);
+      const bool ran_free = d.cross(v).squaredNorm() <= 1e-18 * d.squaredNorm() * v.squaredNorm();
+      const double aim = ran_free ? kLeadAim : kLeadAimAfterCollision;
+      const BodyState b = s.body(i);
+      double margin;
+      if constexpr (kMixture) margin = body_margin(kinds_[s.species[i]].inscribed * s.scale[i]);
+      else margin = margin_;
+      const double room = shell_ - margin;
+      const Motion m(b);
+      Obb cand;
+      cand.half = half;
+      Quat q;
+      auto clearance_after = [&](double tau) {
+        Vec3 w;
+        m.pose(tau, q, w);
+        cand.centre = b.r;
+        for (int k = 0; k < 3; ++k)
+          if (box.periodic[k]) cand.centre[k] += b.v[k] * tau;
+        cand.axes = q.toRotationMatrix();
+        if constexpr (kMixture) {
+          const Kind& kind = kinds_[s.species[i]];
+          const double sc = s.scale[i];
+          const AnyShape shape = sc == 1.0 ? kind.shape : resized(kind.shape, sc);
+          return std::visit([&](const auto& x) { return clearance(x, b.r, b.q, cand); }, shape);
+        } else {
+          return clearance(shape_, b.r, b.q, cand);
         }
-        for (int attempt = 0; attempt < 3 && c < margin + kLeadNeed * room; ++attempt) {
-          tau *= 0.5;
-          c = clearance_after(tau);
-        }
-        if (c >= margin + kLeadNeed * room) {
-          ++leads_;
-          box.wrap(cand.centre);
-          q_[i] = q;
-          obb_[i] = cand;
-          return;
-        }
+      };
+      // a trial lead of one shell's travel, then the secant to the aim: the clearance falls
+      // from shell (no lead) about linearly with tau
+      double tau = shell_ / std::sqrt(v.squaredNorm());
+      double c = clearance_after(tau);
+      if (c < shell_) {
+        tau *= (shell_ - (margin + aim * room)) / (shell_ - c);
+        c = clearance_after(tau);
+      }
+      for (int attempt = 0; attempt < 3 && c < margin + kLeadNeed * room; ++attempt) {
+        tau *= 0.5;
+        c = clearance_after(tau);
+      }
+      if (c >= margin + kLeadNeed * room) {
+        ++leads_;
+        box.wrap(cand.centre);
+        q_[i] = q;
+        obb_[i] = cand;
+        return;
       }
     }
     set_box(i, s.r[i], s.q[i], half);
@@ -494,8 +496,9 @@ class ObbNeighbors {
   Box pbox_;
   bool lead_ = true;            // boxes led along the flight (set_lead)
   std::uint64_t leads_ = 0;     // rebuilds that led the box
-  // the clearance the secant aims at and the least it accepts, in units of shell - margin
-  static constexpr double kLeadAim = 0.2, kLeadNeed = 0.1;
+  // the clearance the secant aims at (after a free run; after a collision) and the least it
+  // accepts, in units of shell - margin
+  static constexpr double kLeadAim = 0.2, kLeadAimAfterCollision = 0.6, kLeadNeed = 0.1;
  public:
   std::uint64_t led_ = 0;
  private:
