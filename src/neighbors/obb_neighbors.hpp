@@ -499,9 +499,6 @@ class ObbNeighbors {
   // the clearance the secant aims at (after a free run; after a collision) and the least it
   // accepts, in units of shell - margin
   static constexpr double kLeadAim = 0.2, kLeadAimAfterCollision = 0.6, kLeadNeed = 0.1;
- public:
-  std::uint64_t led_ = 0;
- private:
   Vec3 ext_ = Vec3::Ones();  // body extents along its axes (max of half_extents and support)
   double margin_ = 0.0, eps_ = 0.0;
   double rc_ = 0.0;          // box circumradius (a mixture: the largest)
