@@ -26,7 +26,8 @@
 // contact with the shrunken box. Shapes of bounded curvature also give |d_f''| <= M_f
 // (curvature_bound), and the search then takes second-order steps where they are longer; flat
 // faces of rigid bodies (no curvature bound) take steps on a concave lower bound instead
-// (affine_bound).
+// (affine_bound), and their Lipschitz steps use the fastest fall D_f (approach_bound) instead
+// of K_f: a face the body recedes from does not limit them.
 // Growth: with scale s(t) = scale + scale_rate (t - t_state) the body is its shape scaled by s(t)
 // about its centre (Lubachevsky–Stillinger starts against walls, locals/planar_walls.hpp):
 // d_f(t) = c - margin - n.r(t) - s(t) h(R(t)^T n), d_f' gains -s' h and its rotational part the
@@ -226,11 +227,25 @@ struct BoxDistance {
     const double h = (f & 1) ? shape.support(mm) : shape.support(Vec3(-mm));
     return lim[k] + ((f & 1) ? -x : x) - s0 * (h + 0.5 * Q[k] * s * s);
   }
+  // B_f(s) <= d_f + d_f' s - Q_f s^2 / 2 (first_root's trial for affine_step): h is convex, so
+  // h(+-(m + s m')) >= h(+-m) + s p.(+-m') (p the support point, a subgradient), and the linear
+  // part of that is the exact rate d_f' (the rates of at(), the same support point).
+  double affine_curvature(int f) const { return s0 * Q[f >> 1]; }
   // |d_f'| <= K_f (a top that is not spherical: |w x u| <= max |w(t)|)
   double rate_bound(int f) const {
     const Vec3 u = axes.col(f >> 1);
     const double wu = motion.spherical() ? st.w.cross(u).norm() : motion.max_angular_speed();
     return std::abs(st.v.dot(u)) + wu * lever * smax + std::abs(sdot) * L;
+  }
+  // -d_f' <= D_f, the fastest fall: d_f' is the translation's -+u.v (constant in free flight)
+  // plus the turn's and the growth's parts, each bounded as in K_f, so D_f = max(0, +-u.v +
+  // turn + growth) (face 2k: lim + x_k - ..., falls as the centre moves along -u; 2k + 1 along
+  // +u). A face the centre recedes from faster than the turn can bring it back has D_f = 0.
+  double approach_bound(int f) const {
+    const Vec3 u = axes.col(f >> 1);
+    const double wu = motion.spherical() ? st.w.cross(u).norm() : motion.max_angular_speed();
+    const double vn = st.v.dot(u);
+    return std::max(0.0, ((f & 1) ? vn : -vn) + wu * lever * smax + std::abs(sdot) * L);
   }
 };
 

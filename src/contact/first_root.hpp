@@ -4,6 +4,7 @@
 // The rules (one place for all searches; each is derived where it is defined below):
 //   lipschitz_step  from g >= 0 with |g'| <= K: no zero of g before t + max(g, eps) / K when
 //                   g >= eps (the floor eps keeps steps near a root at least eps / K long);
+//                   only the fall matters: with g' >= -D (D <= K) the step is max(g, eps) / D;
 //   curvature_step  from g >= 0 with rate g' and |g''| <= M: no zero before the positive root
 //                   of g + g' dt - M dt^2 / 2;
 //   affine_step     from g >= 0 with rate g' and a concave lower bound B(s) of g(t + s): no
@@ -34,10 +35,14 @@
 //     double component_at(int f, double t) const;                     // d_f(t) alone
 //     double rate_bound(int f) const;                                 // K_f over the window
 // and optionally
+//     double approach_bound(int f) const;      // D_f >= -d_f' over the window (<= K_f; the
+//                                              // fastest fall: a receding face's is small)
 //     double curvature_bound(int f) const;     // M_f >= |d_f''| over the window (kInf: none)
 //     bool has_affine_bound(int f) const;      // and, for components without M_f:
 //     double affine_bound(int f, double t, double s) const;  // concave B_f(s) <= d_f(t + s),
 //                                              // B_f(0) = d_f(t) (t: the last value's time)
+//     double affine_curvature(int f) const;    // Q_f: B_f(s) <= d_f + d_f' s - Q_f s^2 / 2
+//                                              // (where affine_step tries B first)
 // Output: the first time in the window at which some d_f reaches 0 (the left end of a bracket a
 // few ulps wide, so d_f >= 0 there), the component, and a status: found, none (no root in the
 // window) or negative (some d_f < 0 at t_start: time = t_start, the most negative component).
@@ -46,6 +51,15 @@
 //  1. From t with d_f > 0 no d_f can reach zero before t + d_f / K_f. Step
 //     dt = min_f max(d_f, eps) / K_f (at least eps / K_f per step near a root, so the number of
 //     steps is bounded by (t_max - t_start) max_f K_f / eps plus a logarithmic far part).
+//     One-sided (F's approach_bound, unless FirstRootOptions::one_sided is false: the twin):
+//     a zero needs d_f to fall, so the step is max(d_f, eps) / D_f with D_f >= -d_f' the
+//     fastest fall (D_f = 0: d_f cannot fall, no zero of it in the window). A face the body
+//     recedes from faster than its turn can bring it back then never limits the step; with
+//     the symmetric K_f it took a geometric series of steps while it was near (a neighbour-list
+//     box led ahead of its body starts with the rear face close; neighbors/obb_neighbors.hpp).
+//     Such a step (d_f >= eps) is rigorous, so no dip is searched on it. Only components
+//     without a curvature bound take it: the curvature step (below) follows a receding d_f
+//     already, and D_f cost an ellipsoid's escape search 3 % more instructions for nothing.
 //  2. A component with d_f <= 0 at the end of a step brackets a root on that step.
 //  3. A component with d0 + d1 <= K_f dt (the only case in which the Lipschitz bound allows a
 //     hidden dip below zero; both ends are then within eps) whose rate goes from - to + inside
@@ -96,14 +110,20 @@ inline double curvature_step(double g, double r, double M) {
 }
 
 // From g >= 0 with rate r at t, and B(s) a concave lower bound of g(t + s) on [0, rest] with
-// B(0) = g: a step with no zero of g before it. Trial: where g's tangent reaches zero (at most
-// rest; 16 dt1 when the tangent never does, dt1 the first-order step). If B(trial) > 0 the
-// trial is safe (B is concave and positive at both ends); otherwise the chord from (0, g) to
-// (trial, B(trial)) reaches zero before B does (B lies above its chords), and that is the step.
-// Near a root approached at a finite rate this is a Newton step with a quadratic correction.
+// B(0) = g: a step with no zero of g before it. If B(trial) > 0 the trial is safe (B is concave
+// and positive at both ends); otherwise the chord from (0, g) to (trial, B(trial)) reaches zero
+// before B does (B lies above its chords), and that is the step. Any trial in (0, rest] is
+// therefore rigorous; the trial only decides how long the step is. With Q > 0 such that
+// B(s) <= g + r s - Q s^2 / 2 (F's affine_curvature), the trial is that parabola's positive root
+// (curvature_step(g, r, Q)): B's own root is no later, and where B is near the parabola the
+// chord lands near B's root. Without Q: where g's tangent reaches zero (a Newton step with a
+// quadratic correction near a root approached at a finite rate), or, for a receding g, 16 dt1
+// (dt1 the first-order step), whose chord is short when B falls fast beyond (measured in a
+// fluid of (2, 2, 8) superquadrics: the parabola's root gave 4.3 steps an escape search
+// against 5.0; docs/benchmarks/README.md). At most rest.
 template <class B>
-double affine_step(B&& bound, double g, double r, double rest, double dt1) {
-  double s = std::min(r < 0.0 ? g / -r : kInf, rest);
+double affine_step(B&& bound, double g, double r, double rest, double dt1, double Q = 0.0) {
+  double s = std::min(Q > 0.0 ? curvature_step(g, r, Q) : r < 0.0 ? g / -r : kInf, rest);
   if (!(s < kInf)) s = 16.0 * dt1;
   const double b = bound(s);
   if (b > 0.0) return s;
@@ -134,6 +154,9 @@ struct FirstRootOptions {
   // Use F's affine_bound on the components without a curvature bound (false: Lipschitz steps
   // only there, the slow twin).
   bool affine_steps = true;
+  // Lipschitz steps on F's approach_bound D_f, the fastest fall of d_f (false: on K_f, the
+  // symmetric bound: the twin).
+  bool one_sided = true;
   // A bracket stops shrinking once its left end's value is at most this (a length: the time
   // returned is then the root's up to value_tol / |d_f'| earlier, never later). 0: shrink to a
   // few ulps (contacts, where the root itself is the event). The neighbour-list escape uses a
@@ -172,6 +195,14 @@ FirstRoot first_root(const F& fn, double t_start, double t_max, double eps_in,
       M[f] = o.second_order ? fn.curvature_bound(f) : kInf;
       curv = curv || std::isfinite(M[f]);
     }
+  }
+  // the fastest fall of each d_f (<= K_f), for the components without a curvature bound (the
+  // curvature step already follows a receding d_f)
+  std::array<double, m> D = K;
+  if constexpr (requires { fn.approach_bound(0); }) {
+    if (o.one_sided)
+      for (int f = 0; f < m; ++f)
+        if (!std::isfinite(M[f])) D[f] = std::min(K[f], fn.approach_bound(f));
   }
   bool affine = false;  // some component (without a curvature bound) takes affine steps
   if constexpr (requires { fn.affine_bound(0, 0.0, 0.0); }) {
@@ -213,9 +244,14 @@ FirstRoot first_root(const F& fn, double t_start, double t_max, double eps_in,
       safe[f] = 0.0;
       step[f] = kInf;
       if (!(K[f] > 0.0)) continue;
-      step[f] = lipschitz_step(d0[f], eps, K[f]);
+      if (!(D[f] > 0.0)) {  // d_f cannot fall: no zero of it in the window
+        safe[f] = kInf;
+        continue;
+      }
+      step[f] = lipschitz_step(d0[f], eps, D[f]);
+      if (D[f] < K[f] && d0[f] >= eps) safe[f] = step[f];  // rigorous (no dip to search for)
       if (curv && std::isfinite(M[f])) {
-        safe[f] = curvature_step(d0[f], dd0[f], M[f]);
+        safe[f] = std::max(safe[f], curvature_step(d0[f], dd0[f], M[f]));
         step[f] = std::max(step[f], safe[f]);
       }
     }
@@ -230,8 +266,11 @@ FirstRoot first_root(const F& fn, double t_start, double t_max, double eps_in,
         if (!aff[g] || tried[g] || !(step[g] < kInf)) break;
         tried[g] = true;
         ++out.bounds;
-        safe[g] = affine_step([&](double s) { return fn.affine_bound(g, t, s); }, d0[g], dd0[g],
-                              t_max - t, step[g]);
+        double Q = 0.0;
+        if constexpr (requires { fn.affine_curvature(0); }) Q = fn.affine_curvature(g);
+        safe[g] = std::max(safe[g],
+                           affine_step([&](double s) { return fn.affine_bound(g, t, s); }, d0[g],
+                                       dd0[g], t_max - t, step[g], Q));
         step[g] = std::max(step[g], safe[g]);
       }
     }

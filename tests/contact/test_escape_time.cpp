@@ -115,8 +115,27 @@ TEST(EscapeTime, RatesMatchFiniteDifferences) {
       EXPECT_NEAR(D.face_at(f, t), d[f], 1e-13);
       EXPECT_NEAR(D.face_rate(f, t), dd[f], 1e-12);
       EXPECT_LE(std::abs(dd[f]), D.rate_bound(f) * (1 + 1e-12));
+      // the one-sided bound: d_f falls no faster than D_f (<= K_f)
+      EXPECT_GE(dd[f], -D.approach_bound(f) * (1 + 1e-12) - 1e-14);
+      EXPECT_LE(D.approach_bound(f), D.rate_bound(f));
     }
   }
+}
+
+// The one-sided bound is tight where the translation dominates: a body moving along a box axis
+// without turning falls onto the face ahead at exactly |v| and cannot reach the face behind.
+TEST(EscapeTime, ApproachBoundOfATranslatingBody) {
+  const Ellipsoid e{1.0, 0.5, 0.3};
+  const BodyState s{Vec3::Zero(), Quat::Identity(), Vec3(2.0, 0.0, 0.0), Vec3::Zero()};
+  const BoxDistance<Ellipsoid> D(e, s, 0.0, box_around(e, s, 0.2), 0.01);
+  EXPECT_EQ(D.approach_bound(0), 0.0);  // the face at -x (obb.hpp: 2k at -u_k, 2k + 1 at +u_k)
+  EXPECT_EQ(D.approach_bound(1), 2.0);
+  EXPECT_EQ(D.rate_bound(0), 2.0);
+  const EscapeResult a = escape_time(EscapeInput<Ellipsoid>{e, s, 0.0, 0.0, 10.0,
+                                                            box_around(e, s, 0.2), 0.01, 0.01});
+  ASSERT_EQ(a.status, EscapeStatus::escapes);
+  EXPECT_EQ(a.face, 1);
+  EXPECT_NEAR(a.time, (0.2 - 0.01) / 2.0, 1e-14);
 }
 
 // A shape that does not declare itself centrally symmetric (the same ellipsoid or
@@ -246,8 +265,10 @@ TEST(EscapeTime, SecondOrderStepsGiveTheSameEscapesInFewerSteps) {
   for (int k = 0; k < n; ++k) {
     const Flight f = random_flight(r);
     const EscapeInput<Ellipsoid> in = f.input();
-    EscapeOptions slow;
+    EscapeOptions slow;  // the paper's steps: Lipschitz on the symmetric K_f
     slow.second_order = false;
+    slow.affine_steps = false;  // (else the components without M_f take affine steps)
+    slow.one_sided = false;
     const EscapeResult a = escape_time(in, slow), b = escape_time(in);
     steps1 += a.steps, steps2 += b.steps;
     ASSERT_EQ(a.status, b.status) << "case " << k;
@@ -260,8 +281,9 @@ TEST(EscapeTime, SecondOrderStepsGiveTheSameEscapesInFewerSteps) {
               "largest relative time difference %.1e\n", n, escapes, steps1, steps2, worst);
   EXPECT_LE(worst, 1e-12);
   EXPECT_GT(escapes, n / 2);
-  // fewer steps: 14420 against 20836 (0.69) with the rotation lever in K_f (45961 with the
-  // bounding radius, when the second-order steps saved 59 %)
+  // fewer steps: 14420 against 29309 (0.49). (Until the twin turned its affine steps off as
+  // well, it took them on these faces, its M_f being off: 20836 steps; 45961 with the bounding
+  // radius in K_f instead of the rotation lever.)
   EXPECT_LT(steps2, 0.8 * steps1);
 }
 
@@ -329,6 +351,7 @@ TEST(EscapeTime, AffineBoundIsConcaveAndBelowTheFaceDistance) {
   testing::Rng r(83);
   const int n = hb::testing::scaled_count(1500, 0.1);
   double excess = -kInf, excess_noq = -kInf, concavity = -kInf, start = 0.0;
+  double above_parabola = -kInf, fall = -kInf;
   for (int k = 0; k < n; ++k) {
     const FlatFlight fl = random_flat_flight(r, k);
     const BoxDistance<Superquadric> D(fl.q, fl.s, 0.0, fl.box, fl.margin);
@@ -340,11 +363,16 @@ TEST(EscapeTime, AffineBoundIsConcaveAndBelowTheFaceDistance) {
     for (int f = 0; f < 6; ++f) {
       ASSERT_TRUE(D.has_affine_bound(f));
       start = std::max(start, std::abs(D.affine_bound(f, t, 0.0) - d[f]) / L);
+      // d_f falls no faster than D_f (relative to K_f)
+      fall = std::max(fall, (-dd[f] - D.approach_bound(f)) / D.rate_bound(f));
       double prev2 = 0.0, prev1 = 0.0;
       for (int j = 0; j <= 32; ++j) {
         const double s = S_max * j / 32;
         const double b = D.affine_bound(f, t, s), v = D.face_at(f, t + s);
         excess = std::max(excess, (b - v) / L);
+        // below the parabola whose root affine_step tries: d + d' s - Q s^2 / 2
+        above_parabola = std::max(
+            above_parabola, (b - (d[f] + dd[f] * s - 0.5 * D.affine_curvature(f) * s * s)) / L);
         excess_noq = std::max(excess_noq, (b + 0.5 * D.Q[f >> 1] * s * s - v) / L);
         if (j >= 2) concavity = std::max(concavity, (b - 2.0 * prev1 + prev2) / L);
         prev2 = prev1, prev1 = b;
@@ -352,9 +380,12 @@ TEST(EscapeTime, AffineBoundIsConcaveAndBelowTheFaceDistance) {
     }
   }
   std::printf("[ ESCAPE ] %d flights: max (B - d) / L %.2e (without the remainder term %.2e), "
-              "max second difference of B / L %.2e, |B(0) - d| / L %.2e\n",
-              n, excess, excess_noq, concavity, start);
+              "max second difference of B / L %.2e, |B(0) - d| / L %.2e, max (B - parabola) / L "
+              "%.2e, max (-d' - D) / K %.2e\n",
+              n, excess, excess_noq, concavity, start, above_parabola, fall);
   EXPECT_LE(excess, 1e-12);     // a lower bound of the face distance
+  EXPECT_LE(above_parabola, 1e-12);
+  EXPECT_LE(fall, 1e-12);
   EXPECT_GT(excess_noq, 1e-6);  // and the remainder term is needed for that
   EXPECT_LE(concavity, 1e-12);  // concave
   EXPECT_LE(start, 1e-14);
@@ -386,10 +417,58 @@ TEST(EscapeTime, AffineStepsGiveTheSameEscapesInFewerSteps) {
               n, escapes, steps1, steps2, bounds, worst);
   EXPECT_LE(worst, 1e-12);
   EXPECT_GT(escapes, n / 2);
-  // A quarter fewer steps at least (0.63 measured). Each affine step also evaluates about two
-  // bounds (one support function each), so on these flights the work is about even; in the
-  // neighbour lists of a (2, 2, 8) fluid the instructions fell (docs/benchmarks/README.md).
+  // A quarter fewer steps at least (0.54 measured; 0.66 before the one-sided steps and the
+  // trial at the parabola's root). Each affine step also evaluates about two bounds (one
+  // support function each); in the neighbour lists of a (2, 2, 8) fluid the instructions fell
+  // (docs/benchmarks/README.md).
   EXPECT_LT(4 * steps2, 3 * steps1);
+}
+
+// The one-sided steps (FirstRootOptions::one_sided: Lipschitz steps on the fastest fall D_f)
+// against the twin on the symmetric K_f, in boxes led ahead of their bodies as the neighbour
+// lists lead them (the centre moved along v by up to 0.7 of the shell: the rear face starts
+// close): flat faces (affine steps; the components with a curvature bound do not take
+// one-sided steps) and ellipsoids on Lipschitz steps alone: the same status, face and time
+// (both bracketed to a few ulps), in fewer steps.
+TEST(EscapeTime, OneSidedStepsGiveTheSameEscapesInFewerSteps) {
+  testing::Rng r(1618);
+  long steps_e[2] = {0, 0}, steps_q[2] = {0, 0}, escapes = 0;
+  double worst = 0.0;
+  const int n = hb::testing::scaled_count(3000, 0.05);
+  auto lead = [&](Obb box, const BodyState& s, double shell) {
+    const double v = s.v.norm();
+    if (v > 0.0) box.centre += r.uni(0.0, 0.7) * shell * s.v / v;
+    return box;
+  };
+  auto compare = [&](const auto& in, long* steps, int k, EscapeOptions o) {
+    EscapeOptions twin = o;
+    twin.one_sided = false;
+    const EscapeResult a = escape_time(in, twin), b = escape_time(in, o);
+    steps[0] += a.steps, steps[1] += b.steps;
+    ASSERT_EQ(a.status, b.status) << "case " << k;
+    if (a.status != EscapeStatus::escapes) return;
+    ++escapes;
+    EXPECT_EQ(a.face, b.face) << "case " << k;
+    worst = std::max(worst, std::abs(a.time - b.time) / std::max(1.0, a.time));
+  };
+  for (int k = 0; k < n; ++k) {
+    Flight f = random_flight(r);
+    f.box = lead(f.box, f.s, (f.box.half - f.e.half_extents()).minCoeff());
+    EscapeOptions lipschitz;
+    lipschitz.second_order = false, lipschitz.affine_steps = false;
+    compare(f.input(), steps_e, k, lipschitz);
+    FlatFlight q = random_flat_flight(r, k);
+    q.box = lead(q.box, q.s, (q.box.half - q.q.half_extents()).minCoeff());
+    compare(q.input(), steps_q, k, EscapeOptions{});
+  }
+  std::printf("[ ESCAPE ] %d ellipsoid and %d flat-faced flights in led boxes, %ld escapes: "
+              "steps %ld -> %ld (ellipsoids, Lipschitz), %ld -> %ld (flat faces), largest "
+              "relative time difference %.1e\n",
+              n, n, escapes, steps_e[0], steps_e[1], steps_q[0], steps_q[1], worst);
+  EXPECT_LE(worst, 1e-12);
+  EXPECT_GT(escapes, n);
+  EXPECT_LT(steps_e[1], steps_e[0]);
+  EXPECT_LT(steps_q[1], steps_q[0]);
 }
 
 TEST(EscapeTime, AlreadyOutsideGivesStartTime) {
