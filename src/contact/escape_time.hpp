@@ -231,21 +231,24 @@ struct BoxDistance {
   // h(+-(m + s m')) >= h(+-m) + s p.(+-m') (p the support point, a subgradient), and the linear
   // part of that is the exact rate d_f' (the rates of at(), the same support point).
   double affine_curvature(int f) const { return s0 * Q[f >> 1]; }
-  // |d_f'| <= K_f (a top that is not spherical: |w x u| <= max |w(t)|)
-  double rate_bound(int f) const {
+  // The turn's part of |d_f'|: |w x u| lever s_max (a top that is not spherical: |w x u| <=
+  // max |w(t)|)
+  double turn_rate_bound(int f) const {
     const Vec3 u = axes.col(f >> 1);
     const double wu = motion.spherical() ? st.w.cross(u).norm() : motion.max_angular_speed();
-    return std::abs(st.v.dot(u)) + wu * lever * smax + std::abs(sdot) * L;
+    return wu * lever * smax;
+  }
+  // |d_f'| <= K_f
+  double rate_bound(int f) const {
+    return std::abs(st.v.dot(axes.col(f >> 1))) + turn_rate_bound(f) + std::abs(sdot) * L;
   }
   // -d_f' <= D_f, the fastest fall: d_f' is the translation's -+u.v (constant in free flight)
   // plus the turn's and the growth's parts, each bounded as in K_f, so D_f = max(0, +-u.v +
   // turn + growth) (face 2k: lim + x_k - ..., falls as the centre moves along -u; 2k + 1 along
   // +u). A face the centre recedes from faster than the turn can bring it back has D_f = 0.
   double approach_bound(int f) const {
-    const Vec3 u = axes.col(f >> 1);
-    const double wu = motion.spherical() ? st.w.cross(u).norm() : motion.max_angular_speed();
-    const double vn = st.v.dot(u);
-    return std::max(0.0, ((f & 1) ? vn : -vn) + wu * lever * smax + std::abs(sdot) * L);
+    const double vn = st.v.dot(axes.col(f >> 1));
+    return std::max(0.0, ((f & 1) ? vn : -vn) + turn_rate_bound(f) + std::abs(sdot) * L);
   }
 };
 
