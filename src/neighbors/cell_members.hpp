@@ -68,9 +68,10 @@ class CellMembers {
   // for |x| < P_k; P_k = kInf: no period). Conservative: every member whose stored centre
   // (m.centre(), in double precision) is within reach is reported, with some slightly beyond.
   // Callers widen reach by rounding_bound() for the distance to the centres they inserted.
-  // Four single-precision lanes per member (its record is 16 bytes: x, y, z, id), no branch but
-  // the test: about 17 instructions a member where the double-precision loop took 38 (GCC 12,
-  // docs/benchmarks/README.md, "Session of 2026-12-01"). The float arithmetic (the conversions
+  // Four single-precision lanes per member (its record is 16 bytes: x, y, z, id), no branch per
+  // member: about 17 instructions a member where the double-precision loop took 38 (GCC 12,
+  // docs/benchmarks/README.md, "Session of 2026-12-01"); the ids that pass go to a block buffer
+  // and fn is called for them after the block ("Session of 2026-12-03, fourth part"). The float arithmetic (the conversions
   // of from and P, the subtraction, P - |x|, the squares and their sum) errs by less than
   // 2^-21 S in the distance, S = max_abs + max|from| + max finite P + reach (2^-24 relative per
   // operation); the cut-off is widened by 1e-5 S, twenty times that.

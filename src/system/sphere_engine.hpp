@@ -193,10 +193,7 @@ class SphereEngine {
     // j's neighbours are asked for while i is predicted (N = 10^6: -6 %; asking for the
     // partner's list one event ahead, or for all three lines of each list, made it 20-30 %
     // slower, measured the same way: docs/benchmarks/README.md)
-    if (prefetch_) {
-      const std::uint32_t* l = &nb_[std::size_t(j) * kMaxNeighbours];
-      for (std::uint32_t k = 0, nn = p_[j].nn; k < nn; ++k) __builtin_prefetch(&p_[l[k]]);
-    }
+    if (prefetch_) prefetch_neighbours(j);
     predict(i);
     predict(j);
     prefetch_next();
@@ -259,6 +256,8 @@ class SphereEngine {
   int axis_cell(double x, int k) const {
     return std::min(ncell_[k] - 1, static_cast<int>(x / cell_len_[k]));
   }
+  // Grid cell c's slots (used_[c] of them in use).
+  std::uint32_t* slots_of(std::uint32_t c) { return &slot_[std::size_t(c) * cap_]; }
   std::uint32_t cell_of(const Cage& c) const {
     int idx[3];
     for (int k = 0; k < 3; ++k) idx[k] = axis_cell(c[k], k);
@@ -273,10 +272,7 @@ class SphereEngine {
     q_.prefetch_ahead();
     const std::uint32_t i = q_.top();
     prefetch_event(i, q_.top_tag());
-    if (prefetch_far_) {  // and the records its prediction will read
-      const std::uint32_t* l = &nb_[std::size_t(i) * kMaxNeighbours];
-      for (std::uint32_t k = 0, nn = p_[i].nn; k < nn; ++k) __builtin_prefetch(&p_[l[k]]);
-    }
+    if (prefetch_far_) prefetch_neighbours(i);  // the records its prediction will read
     std::uint32_t slot[2], tag[2];
     const int m = q_.next_after_top(slot, tag);
     for (int k = 0; k < m; ++k) prefetch_event(slot[k], tag[k]);
@@ -286,6 +282,12 @@ class SphereEngine {
     __builtin_prefetch(&cage_[i]);
     __builtin_prefetch(&nb_[std::size_t(i) * kMaxNeighbours]);
     if (partner != kCage) __builtin_prefetch(&p_[partner]);
+  }
+
+  // The records of i's listed neighbours (a prediction of i reads them all).
+  void prefetch_neighbours(std::uint32_t i) const {
+    const std::uint32_t* l = &nb_[std::size_t(i) * kMaxNeighbours];
+    for (std::uint32_t k = 0, nn = p_[i].nn; k < nn; ++k) __builtin_prefetch(&p_[l[k]]);
   }
 
   void advance(std::uint32_t i) {
@@ -338,13 +340,13 @@ class SphereEngine {
     };
     if (!prefetch_) {
       for (int c = 0; c < 27; ++c) {
-        const std::uint32_t* cell = &slot_[std::size_t(cells[c]) * cap_];
+        const std::uint32_t* cell = slots_of(cells[c]);
         const std::uint32_t used = used_[cells[c]];
         for (std::uint32_t q = 0; q < used; ++q) consider(cell[q]);
       }
     } else {
       for (int c = 0; c < 27; ++c) {
-        const std::uint32_t* cell = &slot_[std::size_t(cells[c]) * cap_];
+        const std::uint32_t* cell = slots_of(cells[c]);
         __builtin_prefetch(&used_[cells[c]]);
         __builtin_prefetch(cell);
         __builtin_prefetch(cell + cap_ - 1);
@@ -352,7 +354,7 @@ class SphereEngine {
       std::uint32_t* cand = cand_.data();  // 27 cap_ entries
       std::uint32_t n = 0;
       for (int c = 0; c < 27; ++c) {
-        const std::uint32_t* cell = &slot_[std::size_t(cells[c]) * cap_];
+        const std::uint32_t* cell = slots_of(cells[c]);
         const std::uint32_t used = used_[cells[c]];
         for (std::uint32_t q = 0; q < used; ++q) cand[n++] = cell[q];
       }
@@ -435,7 +437,7 @@ class SphereEngine {
   }
 
   void erase_cell(std::uint32_t c, std::uint32_t i) {  // i is in cell c
-    std::uint32_t* cell = &slot_[std::size_t(c) * cap_];
+    std::uint32_t* cell = slots_of(c);
     const std::uint32_t nc = used_[c];
     std::uint32_t q = 0;
     while (cell[q] != i) ++q;
