@@ -125,8 +125,9 @@ class SphereEngine {
     if (finite > 0 && sum > 0.0) q_.set_width(Calendar::kPerBucket * (sum / finite) / n);
     reorder_every_ = 16 * std::uint64_t(n);
     reorder();
-    prefetch_ = bytes_per_sphere() * n > l2_bytes();
-    prefetch_far_ = bytes_per_sphere() * n > kFarBytes;
+    const std::size_t bytes = bytes_per_sphere() * n;
+    prefetch_ = bytes > l2_bytes();
+    prefetch_far_ = bytes > kFarBytes;
   }
 
   // Ask for the data of coming events and of neighbours ahead of their use (memory prefetches;
