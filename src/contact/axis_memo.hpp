@@ -13,6 +13,15 @@
 // 16 / 32 / 64 slots -6.5 / -9.3 / -10.0 % instructions; 32 slots of floats -7.3 % (the
 // collision's distance solve then needs one more Newton step), of 16-bit octahedral pairs
 // -4.8 %. 32 slots of doubles: 1 kB a body.
+//
+// Both sides: every solve stores its axis in i's slot for j and, negated, in j's slot for i
+// (store_both), so each side's slot holds the pair's latest axis (unless another partner took
+// the slot since) and a lookup from either side finds it in its own slots. Storing only the
+// solving side's slot left the other side's older axis in place, which find_either then
+// preferred, and at large N sent a lookup to the partner's slots (a cache miss) whenever the
+// own slot missed. Measured (docs/benchmarks/README.md, "Session of 2026-12-03, fifth part"):
+// solves per collision -7 % at X0 = 10, phi = 0.4, -5 % at X0 = 2, phi = 0.5; time -1 % at
+// N = 256000 (three alternating rounds, each faster), -1 to -3 % at X0 = 10.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -48,7 +57,8 @@ class AxisMemo {
     n = -n;
     return true;
   }
-  // The contact normal of a collision of i and j (from i to j), for both sides.
+  // Axis n of a solve or the contact normal of a collision of i and j (from i to j), for both
+  // sides (see the header).
   void store_both(std::size_t n_bodies, std::uint32_t i, std::uint32_t j, const Vec3& n) {
     store(n_bodies, i, j, n);
     store(n_bodies, j, i, Vec3(-n));

@@ -452,7 +452,7 @@ struct RigidBodies {
           if (window) in.window_given = true, in.window_lo = window[0], in.window_hi = window[1];
           memo.find_either(i, j, in.axis_start);
           const ContactResult r = contact_time(in, options);
-          memo.store(s.size(), i, j, r.status == ContactStatus::hit ? r.normal : r.axis);
+          memo.store_both(s.size(), i, j, r.status == ContactStatus::hit ? r.normal : r.axis);
           return r;
         },
         [&](const BodyState& a, const BodyState& b, std::uint32_t j, double horizon) {

@@ -118,7 +118,7 @@ struct RigidMixture {
                 in.growth = sl;
                 memo.find_either(i, j, in.axis_start);
                 const ContactResult r = contact_time(in, options);
-                memo.store(s.size(), i, j, r.status == ContactStatus::hit ? r.normal : r.axis);
+                memo.store_both(s.size(), i, j, r.status == ContactStatus::hit ? r.normal : r.axis);
                 return r;
               },
               sa, body_shape(s, j));
