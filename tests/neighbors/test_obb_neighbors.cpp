@@ -374,6 +374,33 @@ TEST(ObbNeighbors, AxisMemoGivesTheSameCollisionsAsColdStarts) {
   expect_same_energy(fast, cold);
 }
 
+// Every solve stores its axis on both sides (AxisMemo::store_both), so wherever both bodies'
+// slots hold the pair they hold its latest axis, each the other's negative, exactly. (Storing
+// only the solving side's slot, as before, left the partner's older axis behind: the check
+// fails on such a run.)
+TEST(ObbNeighbors, AxisMemoHoldsEachPairsLatestAxisOnBothSides) {
+  RigidSystemSpec spec;
+  spec.seed = 37;
+  spec.phi = 0.45;
+  auto sim = make_ellipsoid_nnl_simulation(spec, 0.15);
+  const std::uint64_t target = hb::testing::scaled_count(3000, 0.05);
+  while (sim.collisions() < target) sim.step(kInf);
+  const AxisMemo& memo = sim.model().memo;
+  const auto n = static_cast<std::uint32_t>(sim.state().size());
+  std::uint64_t both = 0, differ = 0;
+  for (std::uint32_t i = 0; i < n; ++i)
+    for (std::uint32_t j = i + 1; j < n; ++j) {
+      Vec3 a, b;
+      if (!memo.find(i, j, a) || !memo.find(j, i, b)) continue;
+      ++both;
+      if (a != Vec3(-b)) ++differ;
+    }
+  std::printf("[ NNL ] %llu pairs in both sides' slots, %llu of them differing\n",
+              (unsigned long long)both, (unsigned long long)differ);
+  EXPECT_GT(both, 100u);
+  EXPECT_EQ(differ, 0u);
+}
+
 // Solves of a run: predictions not answered by a pre-filter or the ordered loop.
 std::uint64_t solves(const SolverStats& s) { return s.predictions - s.prefiltered; }
 
