@@ -316,10 +316,11 @@ Vec3 separating_axis_at(const SA& sa, const Quat& rot_a, const SB& sb, const Qua
     sep = c + scale * (Rab * qb - qa);
     return n.dot(sep);
   };
-  Vec3 best = c.normalized();
+  Vec3 best;
   if (start && start->squaredNorm() > 0.0) {
-    best = (rot_a_inv * *start).normalized();
+    best = near_unit_normalized(Vec3(rot_a_inv * *start));  // a unit axis, turned: unit to rounding
   } else {
+    best = c.normalized();
     // Rods (a body whose core segment is longer than its thickness, geometry/segment.hpp):
     // start from the direction between the closest points of the core segments instead of
     // the line of centres. It needs fewer Newton steps for long bodies (ellipsoids at

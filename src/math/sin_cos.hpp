@@ -20,9 +20,10 @@ struct SinCos {
 
 inline constexpr double kSinCosPolyMax = 0.8;
 
-inline SinCos sin_cos(double x) {
-  if (!(std::abs(x) <= kSinCosPolyMax)) return {std::sin(x), std::cos(x)};
-  const double z = x * x;
+namespace sin_cos_detail {
+// The Horner parts of the two Taylor polynomials in z = x^2: sin x = x (1 + z ps), cos x =
+// 1 + z pc.
+[[gnu::always_inline]] inline SinCos series(double z) {
   // sin x = x + x z (-1/3! + z (1/5! - ...)): the correction is below x/6, so its rounding
   // error is a fraction of an ulp of the result
   const double ps =
@@ -44,7 +45,23 @@ inline SinCos sin_cos(double x) {
                                z * (-1.0 / 87178291200.0 +
                                     z * (1.0 / 20922789888000.0 +
                                          z * (-1.0 / 6402373705728000.0))))))));
-  return {x + (x * z) * ps, 1.0 + z * pc};
+  return {ps, pc};
+}
+}  // namespace sin_cos_detail
+
+inline SinCos sin_cos(double x) {
+  if (!(std::abs(x) <= kSinCosPolyMax)) return {std::sin(x), std::cos(x)};
+  const double z = x * x;
+  const SinCos p = sin_cos_detail::series(z);
+  return {x + (x * z) * p.s, 1.0 + z * p.c};
+}
+
+// sin(x) / x and cos(x) from z = x^2 alone, for z <= kSinCosPolyMax^2 (the caller checks): the
+// same polynomials, without the square root that x would cost (a rotation by the angle
+// |w| dt / 2 needs only |w|^2, motion/free_rotation.hpp). s = 1 + z ps, a few ulp like sin_cos.
+inline SinCos sinc_cos_of_square(double z) {
+  const SinCos p = sin_cos_detail::series(z);
+  return {1.0 + z * p.s, 1.0 + z * p.c};
 }
 
 }  // namespace hb

@@ -38,9 +38,7 @@ inline Vec3 position_at(const BodyState& b, double dt) { return b.r + b.v * dt; 
 inline Quat orientation_at(const BodyState& b, double dt) {
   if (!spherical_top(b.top))
     return b.rot ? b.rot->orientation(b.rot_t + dt) : FreeRotation::make(b.top, b.q, b.w).orientation(dt);
-  Quat q = rotation_increment(b.w, dt) * b.q;
-  q.normalize();  // keeps |q| = 1 to rounding; the rotation matrix stays orthonormal
-  return q;
+  return spun(b.w, dt, b.q);
 }
 
 // Body -> lab rotation matrix at dt (columns are the body axes in the lab frame).

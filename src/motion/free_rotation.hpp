@@ -106,15 +106,32 @@ namespace hb {
 
 // Quaternion of the rotation by the angle |w| dt about w (exact, no series truncation).
 inline Quat rotation_increment(const Vec3& w, double dt) {
+  // The half angle x = |w| dt / 2 enters only through x^2 and sin(x) / x for the usual small
+  // angles (|x| <= kSinCosPolyMax): q = (cos x, (dt / 2) (sin(x) / x) w), with no square root and
+  // no division (math/sin_cos.hpp, sinc_cos_of_square). w = 0 or dt = 0 give the identity
+  // exactly. Larger angles: sin and cos of x itself, sin(x) / |w| the axis factor.
+  const double z = 0.25 * w.squaredNorm() * dt * dt;
+  if (z <= kSinCosPolyMax * kSinCosPolyMax) {
+    const SinCos sc = sinc_cos_of_square(z);
+    const double s = 0.5 * dt * sc.s;
+    return Quat(sc.c, s * w.x(), s * w.y(), s * w.z());
+  }
   const double wn = w.norm();
-  const double half = 0.5 * wn * dt;
-  if (half == 0.0) return Quat::Identity();
-  // sin(half)/wn is finite even for tiny wn: use sinc form to stay accurate. sin and cos come
-  // together from sin_cos (math/sin_cos.hpp: a polynomial for the usual small angles; separate
-  // libm sin and cos were 7 % of an ellipsoid run's profile, one sincos call 3 %).
-  const SinCos sc = sin_cos(half);
-  const double s = (std::abs(half) < 1e-4) ? 0.5 * dt * (1.0 - half * half / 6.0) : sc.s / wn;
+  const SinCos sc = sin_cos(0.5 * wn * dt);
+  const double s = sc.s / wn;
   return Quat(sc.c, s * w.x(), s * w.y(), s * w.z());
+}
+
+// Scale q back onto the unit sphere (near_unit_normalized, math/types.hpp: a product of unit
+// quaternions is unit to a few ulp, where one Newton step is exact to rounding).
+inline void renormalize(Quat& q) { q.coeffs() = near_unit_normalized(Eigen::Vector4d(q.coeffs())); }
+
+// q0 turned by the constant angular velocity w (lab frame) for a time dt: a spherical top's
+// orientation (motion/free_flight.hpp, orientation_at) and FreeRotation's exact spins.
+[[gnu::always_inline]] inline Quat spun(const Vec3& w, double dt, const Quat& q0) {
+  Quat q = rotation_increment(w, dt) * q0;
+  renormalize(q);  // keeps |q| = 1 to rounding; the rotation matrix stays orthonormal
+  return q;
 }
 
 namespace elliptic {
@@ -417,11 +434,7 @@ struct FreeRotation {
   double RJc_ = 0.0;    // R_J(0, m1, 1, 1 + n)
   elliptic::Jacobi jac_;
 
-  static Quat spin(const Vec3& w, double dt, const Quat& q0) {
-    Quat q = rotation_increment(w, dt) * q0;
-    q.normalize();
-    return q;
-  }
+  static Quat spin(const Vec3& w, double dt, const Quat& q0) { return spun(w, dt, q0); }
 
   // Body' angular velocity and (if psi != nullptr) the rotation angle psi about L at time t
   // (asymmetric top).

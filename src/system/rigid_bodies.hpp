@@ -229,7 +229,7 @@ double memo_or_centres_clear_time(const SA& A, const SB& B, const State& s, std:
   const double age = now - s.t[j], span = horizon - now;
   Vec3 u;
   if (memo.find_either(i, j, u))
-    return axis_clear_time(A, fa, a.w, B, s.q[j], s.w[j], c, Vec3(u.normalized()), dv, age, span,
+    return axis_clear_time(A, fa, a.w, B, s.q[j], s.w[j], c, near_unit_normalized(u), dv, age, span,
                            wa, wb, /*second_order=*/true);
   return centres_clear_time(A, fa, a.w, B, s.q[j], s.w[j], c, dv, age, span, wa, wb,
                             /*second_order=*/true);

@@ -62,4 +62,32 @@ TEST(SinCos, ExactAtZeroAndLibmBeyondTheRange) {
   EXPECT_TRUE(std::isnan(hb::sin_cos(nan).s) && std::isnan(hb::sin_cos(nan).c));
 }
 
+// sinc_cos_of_square(x^2) against the long double sin(x) / x and cos(x): the same bound as
+// sin_cos over the polynomial's range, near zero (where sin(x) / x -> 1) and at its edge.
+TEST(SinCos, SincOfTheSquareIsWithinTwoUlpOfLongDouble) {
+  pcg64 rng(20261203);
+  double ws = 0.0, wc = 0.0;
+  auto add = [&](double x) {
+    const double z = x * x;
+    if (!(z <= hb::kSinCosPolyMax * hb::kSinCosPolyMax)) return;
+    const hb::SinCos r = hb::sinc_cos_of_square(z);
+    const long double lx = std::sqrt(static_cast<long double>(z));  // the x of the rounded z
+    const long double sinc = lx == 0.0L ? 1.0L : std::sin(lx) / lx;
+    ws = std::max(ws, ulp_error(r.s, sinc));
+    wc = std::max(wc, ulp_error(r.c, std::cos(lx)));
+  };
+  std::uniform_real_distribution<double> u(0.0, hb::kSinCosPolyMax);
+  for (int i = 0; i < 200000; ++i) add(u(rng));
+  std::uniform_real_distribution<double> e(-150.0, 0.0);
+  for (int i = 0; i < 20000; ++i) add(std::pow(10.0, e(rng)));
+  double x = hb::kSinCosPolyMax;
+  for (int i = 0; i < 1000; ++i, x = std::nextafter(x, 0.0)) add(x);
+  add(0.0);
+  EXPECT_EQ(hb::sinc_cos_of_square(0.0).s, 1.0);
+  EXPECT_EQ(hb::sinc_cos_of_square(0.0).c, 1.0);
+  EXPECT_LE(ws, 2.0);
+  EXPECT_LE(wc, 2.0);
+  std::printf("max error: sin(x)/x %.3f ulp, cos %.3f ulp\n", ws, wc);
+}
+
 }  // namespace
