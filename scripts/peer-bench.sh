@@ -77,7 +77,7 @@
 # stdout and in DIR/peer_hard_spheres.md, one JSON line per N in DIR/peer_hard_spheres.jsonl.
 #
 # Caveats: compiler flags differ (peer -Ofast -march=native as its Makefile says; hardbody Release
-# -O3 -march=x86-64-v2); the peer uses neighbour lists (shell 1.5) with a cell list; on a loaded
+# -O3 -march=x86-64-v2 with GCC's inlining limits raised, CMakeLists.txt); the peer uses neighbour lists (shell 1.5) with a cell list; on a loaded
 # machine single rounds vary by 10-20 %, use K >= 3.
 set -euo pipefail
 
