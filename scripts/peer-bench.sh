@@ -77,8 +77,9 @@
 # stdout and in DIR/peer_hard_spheres.md, one JSON line per N in DIR/peer_hard_spheres.jsonl.
 #
 # Caveats: compiler flags differ (peer -Ofast -march=native as its Makefile says; hardbody Release
-# -O3 -march=x86-64-v2 with GCC's inlining limits raised, CMakeLists.txt); the peer uses neighbour lists (shell 1.5) with a cell list; on a loaded
-# machine single rounds vary by 10-20 %, use K >= 3.
+# -O3 -march=x86-64-v2, with GCC's inlining limits raised: CMakeLists.txt); the peer uses
+# neighbour lists (shell 1.5) with a cell list; on a loaded machine single rounds vary by
+# 10-20 %, use K >= 3.
 set -euo pipefail
 
 usage() { sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }

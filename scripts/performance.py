@@ -285,6 +285,12 @@ def source_of(build):
     """Where the measured binaries come from: the source tree of the build and its commit."""
     src = sh(f"sed -n 's/^CMAKE_HOME_DIRECTORY:INTERNAL=//p' '{build}/CMakeCache.txt'")
     info = {"build": os.path.abspath(build), "source": src}
+    # the optimisation flags the benchmarks were compiled with (-O, -march, GCC's --param pairs)
+    words = sh(f"sed -n 's/^CXX_FLAGS = //p' '{build}/bench/CMakeFiles/bench_rigid.dir/flags.make'").split()
+    keep = [w for k, w in enumerate(words)
+            if w.startswith(("-O", "-march")) or w == "--param" or (k > 0 and words[k - 1] == "--param")]
+    if keep:
+        info["cxx_flags"] = " ".join(keep)
     if os.path.exists(os.path.join(src, "SOURCE_COMMIT")):  # e.g. a `git archive` export
         info["commit"] = open(os.path.join(src, "SOURCE_COMMIT")).read().strip()
         info["source_note"] = "clean `git archive` export of the commit"

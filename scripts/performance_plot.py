@@ -228,7 +228,7 @@ def header(rep):
           "(`CLOCK_PROCESS_CPUTIME_ID`), which a loaded machine still inflates through shared caches "
           "and frequency; each row of the CSV files carries the 1-minute load when it ended (`load1`).",
           f"* Code: commit `{m.get('commit', '?')}` ({m.get('source_note', '')}), Release build "
-          f"(`-O3 -march=x86-64-v2`, GCC's inlining limits raised: CMakeLists.txt). Whole study: {m['cpu_seconds']:.0f} s CPU, {m['wall_seconds']:.0f} s wall.",
+          f"(`{m.get('cxx_flags', '-O3 -march=x86-64-v2')}`). Whole study: {m['cpu_seconds']:.0f} s CPU, {m['wall_seconds']:.0f} s wall.",
           *updates_lines(rep),
           "* Paper: C. De Michele, J. Comput. Phys. 229, 3276 (2010), measured on an Intel Xeon 3.06 GHz "
           "(Prestonia, 512 KB L2, 533 MHz FSB, 2002). Its figures are missing from the source we have "
