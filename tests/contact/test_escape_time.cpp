@@ -122,6 +122,36 @@ TEST(EscapeTime, RatesMatchFiniteDifferences) {
   }
 }
 
+// The turn's parts of a face's bounds come from that face's own box axis (BoxDistance keeps
+// them per axis, formed once): for a spherical top, |w x u_k| lever in K_f and D_f, and
+// rho |w x u_k|^2 + L |w| |w x u_k| in M_f, written out here per face. A spin about one box
+// axis leaves that axis's two faces without a turn and the others with one, so a bound read
+// off the wrong axis fails.
+TEST(EscapeTime, TurnBoundsComeFromTheFacesOwnAxis) {
+  testing::Rng r(17);
+  for (int k = 0; k < 200; ++k) {
+    const Ellipsoid e = r.ellipsoid(10.0);
+    BodyState s{r.ball(1.0), r.quat(), 3.0 * r.unit(), r.log_uni(0.1, 30.0) * r.unit()};
+    const Obb box = box_around(e, s, 0.3);
+    if (k % 2) s.w = r.log_uni(0.1, 30.0) * Vec3(box.axes.col(k % 3));  // about one box axis
+    const BoxDistance<Ellipsoid> D(e, s, 0.0, box, 0.01);
+    const double lever = rotation_lever(e), L = e.bounding_radius();
+    for (int f = 0; f < 6; ++f) {
+      const Vec3 u = box.axes.col(f / 2);
+      const double vn = s.v.dot(u), sw = s.w.cross(u).norm();
+      const double turn = sw * lever;
+      const double tol = 1e-13 * (std::abs(vn) + s.w.norm() * L + 1.0);
+      EXPECT_NEAR(D.rate_bound(f), std::abs(vn) + turn, tol) << "face " << f;
+      EXPECT_NEAR(D.approach_bound(f), std::max(0.0, (f % 2 ? vn : -vn) + turn), tol) << "face " << f;
+      const double M = e.max_curvature_radius() * sw * sw + L * s.w.norm() * sw;
+      EXPECT_NEAR(D.curvature_bound(f), M, 1e-13 * (M + 1.0)) << "face " << f;
+      if (k % 2 && f / 2 == k % 3) {  // the spin axis's faces: no turn
+        EXPECT_LT(D.curvature_bound(f), 1e-9 * (1.0 + s.w.squaredNorm()));
+      }
+    }
+  }
+}
+
 // The one-sided bound is tight where the translation dominates: a body moving along a box axis
 // without turning falls onto the face ahead at exactly |v| and cannot reach the face behind.
 TEST(EscapeTime, ApproachBoundOfATranslatingBody) {
