@@ -41,6 +41,25 @@ inline double angular_acceleration_bound(const Vec3& top, double wmax) {
   return c * wmax * wmax / std::sqrt(3.0);
 }
 
+// Motion::spin_across's bound from a body's orientation q, lab angular velocity w and principal
+// moments `top` at any one time of its flight: |w x e_k| (e_k = q's column k) for a spherical
+// top or a symmetric top about k (constant along the flight; see there), times (1 + 1e-14)
+// plus 1e-14 |w|, a margin for the rounding of e_k and of the poses along the flight (a spin
+// nearly along the axis leaves a small cross product of large vectors); kInf for other tops
+// (no bound beyond |w|'s). The pre-filters of the rigid models take it from the stored state
+// (system/rigid_bodies.hpp spin_bound).
+// Column k of the rotation matrix of the unit quaternion q: the body axis k in the lab.
+inline Vec3 body_axis(const Quat& q, int k) {
+  const double x = q.x(), y = q.y(), z = q.z(), s = q.w();
+  if (k == 0) return Vec3(1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y + s * z), 2.0 * (x * z - s * y));
+  if (k == 1) return Vec3(2.0 * (x * y - s * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z + s * x));
+  return Vec3(2.0 * (x * z + s * y), 2.0 * (y * z - s * x), 1.0 - 2.0 * (x * x + y * y));
+}
+inline double spin_across_bound(const Quat& q, const Vec3& w, const Vec3& top, int k) {
+  if (!spherical_top(top) && top[(k + 1) % 3] != top[(k + 2) % 3]) return kInf;
+  return w.cross(body_axis(q, k)).norm() * (1.0 + 1e-14) + 1e-14 * w.norm();
+}
+
 class Motion {
  public:
   explicit Motion(const BodyState& b) : b_(b) {
@@ -60,12 +79,14 @@ class Motion {
 
   // Copies point at their own rotation when they own one.
   Motion(const Motion& o)
-      : b_(o.b_), rot_(o.rot_), t0_(o.t0_), own_(o.own_), wmax_(o.wmax_), dwmax_(o.dwmax_) {
+      : b_(o.b_), rot_(o.rot_), t0_(o.t0_), own_(o.own_), wmax_(o.wmax_), dwmax_(o.dwmax_),
+        across_k_(o.across_k_), across_(o.across_) {
     if (own_) rot_ = &*own_;
   }
   Motion& operator=(const Motion& o) {
     if (this != &o) {
       b_ = o.b_, rot_ = o.rot_, t0_ = o.t0_, own_ = o.own_, wmax_ = o.wmax_, dwmax_ = o.dwmax_;
+      across_k_ = o.across_k_, across_ = o.across_;
       if (own_) rot_ = &*own_;
     }
     return *this;
@@ -76,6 +97,20 @@ class Motion {
   double max_angular_speed() const { return wmax_; }
   // Bound of |dW/dt|, W the body-frame angular velocity (0 for a spherical top).
   double max_angular_acceleration() const { return dwmax_; }
+  // A bound over the flight of |w x e|, e the body's own axis k in the lab (k = 0, 1, 2), the
+  // part of the angular velocity across that axis (for a body of revolution about k the only
+  // part that moves its surface, shapes/shape.hpp revolution_axis); k < 0: max_angular_speed().
+  // It is constant along the flight for a spherical top (w and the body-frame W = R^T w are
+  // constant, and so is W's part across the body axis) and for a symmetric top about k (Euler's
+  // equations keep W_k, and |W| with it), and is taken at the start (spin_across_bound above,
+  // with its margin). Any other top: max_angular_speed().
+  // Kept for the last k asked (a solve asks once per axis search and per escape search).
+  double spin_across(int k) const {
+    if (k < 0) return wmax_;
+    if (k == across_k_) return across_;
+    across_k_ = k;
+    return across_ = std::min(wmax_, spin_across_bound(b_.q, b_.w, b_.top, k));
+  }
 
   Vec3 position(double tau) const { return b_.r + b_.v * tau; }
   Quat orientation(double tau) const { return rot_ ? rot_->orientation(t0_ + tau) : orientation_at(b_, tau); }
@@ -96,6 +131,8 @@ class Motion {
   double t0_ = 0.0;                    // time of b_ on rot_'s clock
   std::optional<FreeRotation> own_;    // rot_ when b_ brought none
   double wmax_ = 0.0, dwmax_ = 0.0;
+  mutable int across_k_ = -1;  // spin_across's cache: the axis asked last (-1: none)
+  mutable double across_ = 0.0;
 };
 
 }  // namespace hb

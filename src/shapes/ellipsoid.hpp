@@ -51,6 +51,9 @@ struct Ellipsoid {
   // whose largest value for X in [a_min^2, a_max^2] is (a_max - a_min)^2 (attained by two
   // values at the ends of the range).
   double rotation_lever() const { return max_ - min_; }
+  // A spheroid (two equal semi-axes) is a body of revolution about its third axis
+  // (shapes/shape.hpp); a sphere has no rotation lever, so it needs none.
+  int revolution_axis() const { return b == c ? 0 : a == c ? 1 : a == b ? 2 : -1; }
   Vec3 half_extents() const { return Vec3(a, b, c); }
   Vec3 ray_surface(const Vec3& u) const {
     return u / std::sqrt(u.cwiseProduct(u).dot(inv_sq()));

@@ -89,6 +89,24 @@ concept BoundedCurvature = requires { requires S::kBoundedCurvature; };
 inline double rotation_lever_bound(double L, double r_in) {  // sqrt(L^2 - r_in^2)
   return std::sqrt(std::max(0.0, (L - r_in) * (L + r_in)));
 }
+// Bodies of revolution. A shape symmetric under every rotation about its own axis k (k = 0, 1,
+// 2: body x, y, z) declares `revolution_axis()` = k; -1 (the default) declares nothing. For such
+// a body the normal at any surface point x lies in the plane of the axis e and of x (the
+// meridian plane), and so does the support point p of any direction m: x x n and m x p are
+// normal to e. The part of the angular velocity along e then moves no support value and no
+// surface point along its normal (w.(x x n) = w_perp.(x x n), w_perp = w - (w.e) e), and every
+// rate bound above may take |w_perp| = |w x e| in place of |w| (Motion::spin_across). The
+// curvature bounds (|m''|) keep |w|. Spheroids declare it (Ellipsoid). Superquadrics do not
+// yet, though one whose two other semi-axes are equal with exponents 2 is of revolution about
+// its third axis (a flat-ended "cylinder" (2, 2, p) with a = b, about z).
+template <Shape S>
+int revolution_axis(const S& s) {
+  if constexpr (requires { { s.revolution_axis() } -> std::convertible_to<int>; }) {
+    return s.revolution_axis();
+  } else {
+    return -1;
+  }
+}
 template <Shape S>
 double rotation_lever(const S& s) {
   if constexpr (requires { { s.rotation_lever() } -> std::convertible_to<double>; }) {
