@@ -83,7 +83,7 @@ class AxisGap {
   // s0, sdot: the common scale law of both shapes (growth); s0 = 1, sdot = 0 for rigid bodies.
   // The motions are referenced, not copied: they must outlive the AxisGap.
   AxisGap(const SA& sa, const Motion& ma, const SB& sb, const Motion& mb, double t_state,
-          const Vec3& n, double s0 = 1.0, double sdot = 0.0)
+          const Vec3& n, double s0 = 1.0, double sdot = 0.0, bool revolution = true)
       : sa_(sa), sb_(sb), ma_(&ma), mb_(&mb), n_(n), dr_(mb.initial().r - ma.initial().r),
         dv_(mb.initial().v - ma.initial().v), t_state_(t_state), s0_(s0), sdot_(sdot),
         curved_(curved(sa, sb)) {
@@ -94,7 +94,10 @@ class AxisGap {
     const double swa = ta.sw, swb = tb.sw;
     wa_ = a.w.norm(), wb_ = b.w.norm();
     ndv_ = std::abs(n.dot(dv_));
-    rot_ = rotation_lever(sa) * swa + rotation_lever(sb) * swb;  // |dh/dt| <= l |m'|
+    // |dh/dt| <= l |m'|, and <= l |w x e| for a body of revolution about e (shapes/shape.hpp)
+    // (revolution = false: |m'| only, the slow twin)
+    rot_ = rotation_lever(sa) * std::min(swa, ma.spin_across(revolution ? revolution_axis(sa) : -1)) +
+           rotation_lever(sb) * std::min(swb, mb.spin_across(revolution ? revolution_axis(sb) : -1));
     Lsum_ = La + Lb;
     const double mdd_a = ta.mdd, mdd_b = tb.mdd;  // bounds of |m''| per body
     if constexpr (kMayCurve)
@@ -397,7 +400,8 @@ Vec3 separating_axis_at(const SA& sa, const Quat& rot_a, const SB& sb, const Qua
 // of |dW/dt|, motion/motion.hpp; AxisGap above derives both).
 //
 // First order. A support value along u changes at most at l |m'| (the rate bound of AxisGap
-// above, l the rotation lever), so with these turn rates T_A, T_B,
+// above, l the rotation lever; a body of revolution's at l |w x e| too, SpinBound::across), so
+// with these turn rates T_A, T_B,
 //     g_u(now) >= g1 := u.c - h_A(R_A^T u) - h_B(-R_B(t_B)^T u) - T_B age,
 // and g_u falls at most at K_u = |u.dv| + T_A + T_B: g_u(now + tau) >= g1 - K_u tau.
 //
@@ -440,7 +444,18 @@ Vec3 separating_axis_at(const SA& sa, const Quat& rot_a, const SB& sb, const Qua
 struct SpinBound {
   double wmax = -1.0;  // < 0: a spherical top (w constant); else the largest angular speed
   double dwmax = 0.0;  // a bound of |dW/dt| (not spherical tops)
+  // A bound of |w x e| over the flight for a body of revolution about e (shapes/shape.hpp
+  // revolution_axis; motion/motion.hpp spin_across_bound): the first-order turn rate T is
+  // l min(|m'|, across). kInf: none.
+  double across = kInf;
 };
+// SpinBound::across of a body of shape `sh` from its stored orientation, angular velocity and
+// principal moments (kInf unless a body of revolution whose spin across the axis is constant).
+template <Shape S>
+double spin_across_of(const S& sh, const Quat& q, const Vec3& w, const Vec3& top) {
+  const int k = revolution_axis(sh);
+  return k < 0 ? kInf : spin_across_bound(q, w, top, k);
+}
 // Body A's rotation for a run of axis tests against many candidates (one prediction,
 // system/rigid_bodies.hpp): its matrix, formed once; a direction then turns into A's frame and
 // back by a matrix-vector product, half the arithmetic of a quaternion rotation. The tests take
@@ -473,7 +488,10 @@ double axis_clear_time(const SA& sa, const RA& qa, const Vec3& wa, const SB& sb,
     return spin.wmax < 0.0 ? w.cross(u).norm() : spin.wmax;
   };
   const double sw_a = turn_speed(wa, spin_a), sw_b = turn_speed(wb, spin_b);
-  const double turn_a = rotation_lever(sa) * sw_a, turn_b = rotation_lever(sb) * sw_b;
+  // the first-order turn rates: a body of revolution's spin across its axis if smaller (the
+  // curvature bounds below keep |m'| <= sw)
+  const double turn_a = rotation_lever(sa) * std::min(sw_a, spin_a.across);
+  const double turn_b = rotation_lever(sb) * std::min(sw_b, spin_b.across);
   const Vec3 ma = to_body(qa, u), mb = to_body(qb, Vec3(-u));
   const double ha = sa.support(ma), hb = sb.support(mb);
   const double g_old = u.dot(c) - ha - hb;  // B as it was at t_B

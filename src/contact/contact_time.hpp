@@ -214,6 +214,10 @@ struct ContactOptions {
   // support points coincide to accept_tol) instead of a distance solve (false: the distance
   // solve from the axis' touching guess, the slow twin).
   bool touch_from_memo = true;
+  // Rate bounds of bodies of revolution (shapes/shape.hpp revolution_axis) from the spin across
+  // their axes, Motion::spin_across: in K, the axis gaps' K_n and the rigid models' pre-filters
+  // (SpinBound::across; false: from |w|, the slow twin).
+  bool revolution_bounds = true;
   DistanceOptions distance{};
 };
 
@@ -345,6 +349,12 @@ inline double distance_rate_bound(const Motion& a, double la, const Motion& b, d
   return (b.initial().v - a.initial().v).norm() + a.max_angular_speed() * la +
          b.max_angular_speed() * lb;
 }
+// The same with the shapes' axes of revolution ka, kb (shapes/shape.hpp revolution_axis; -1:
+// none): only the part of w across that axis moves the surface, |w x e| <= spin_across(k).
+inline double distance_rate_bound(const Motion& a, double la, int ka, const Motion& b, double lb,
+                                  int kb) {
+  return (b.initial().v - a.initial().v).norm() + a.spin_across(ka) * la + b.spin_across(kb) * lb;
+}
 
 // Upper bound of |d'| over [t0, t1] for bodies scaled by law s(t) (growth; see the header): the
 // levers la, lb for the rotation, the bounding radii La, Lb for the radial swelling.
@@ -474,8 +484,10 @@ struct Solver {
         L(std::max(i.shape_a.bounding_radius(), i.shape_b.bounding_radius()) *
           (grow ? A.scale_at(i.t_start) : 1.0)),
         K(grow ? rate_bound(i.t_start, i.t_start)
-               : distance_rate_bound(A.motion, rotation_lever(i.shape_a), B.motion,
-                                     rotation_lever(i.shape_b))),
+               : distance_rate_bound(A.motion, rotation_lever(i.shape_a),
+                                     op.revolution_bounds ? revolution_axis(i.shape_a) : -1, B.motion,
+                                     rotation_lever(i.shape_b),
+                                     op.revolution_bounds ? revolution_axis(i.shape_b) : -1)),
         warm(i.warm), warm_scale(grow ? A.scale_at(i.t_start) : 1.0) {}
 
   // Rate bound over [t0, t1] (growth: the scale is largest at one end).
@@ -570,7 +582,7 @@ struct Solver {
   double advance_on_axis(const Vec3& n, double t0, double hi, const AxisSupport* at = nullptr) {
     using Gap = AxisGap<SA, SB>;
     Gap G(in.shape_a, A.motion, in.shape_b, B.motion, in.t_state, n, grow ? in.growth.s : 1.0,
-          grow ? in.growth.rate : 0.0);
+          grow ? in.growth.rate : 0.0, o.revolution_bounds);
     // Flat-faced pairs (not curved) of rigid bodies: steps on the affine bound instead.
     if constexpr (kMayBeFlat)
       if (o.affine_steps && !G.is_curved() && G.has_affine_bound()) return advance_affine(G, t0, hi, at);

@@ -67,6 +67,9 @@ struct EscapeInput {
   double eps = 1e-3;      // grazing step length (the paper's epsilon_d^nnl), << body size
   double scale = 1.0;     // growth: the body's scale at t_state and its rate (see above)
   double scale_rate = 0.0;
+  // The turn bounds of a body of revolution from the spin across its axis (BoxDistance::sr;
+  // false: from |w|, the slow twin).
+  bool revolution = true;
 };
 
 using EscapeOptions = FirstRootOptions;  // max_steps exceeded: status inside, `truncated` set
@@ -102,6 +105,10 @@ struct BoxDistance {
   // first_root (six faces, three bounds each) reads them instead of forming one per face and
   // bound (3 square roots instead of 21; the same numbers).
   Vec3 sw, mdd;
+  // The turn speed that moves the support value of face k: sw[k], or the spin across the axis
+  // of a body of revolution if that is smaller (shapes/shape.hpp revolution_axis,
+  // Motion::spin_across). The first-order bounds take it; the curvature keeps sw.
+  Vec3 sr;
   // The body frame at the time of the last evaluation with rates (affine_bound's start):
   // column k of Rn is box axis k in the body frame, W the body-frame angular velocity.
   mutable double frame_tau = kInf;
@@ -109,14 +116,17 @@ struct BoxDistance {
   mutable Vec3 frame_W;
 
   BoxDistance(const S& s, const BodyState& b, double ts, const Obb& box, double margin,
-              double scale = 1.0, double scale_rate = 0.0, double t_end = kInf)
+              double scale = 1.0, double scale_rate = 0.0, double t_end = kInf,
+              bool revolution = true)
       : shape(s), st(b), t_state(ts), axes(box.axes), lim(box.half.array() - margin),
         L(s.bounding_radius()), lever(rotation_lever(s)), motion(b), s0(scale), sdot(scale_rate),
         smax(scale_rate > 0.0 ? scale + scale_rate * (t_end - ts) : scale) {
     st.r = b.r - box.centre;
+    const double across = motion.spin_across(revolution ? revolution_axis(s) : -1);
     for (int k = 0; k < 3; ++k) {
       const TurnBounds tb = turn_bounds(motion, Vec3(axes.col(k)));
       sw[k] = tb.sw, mdd[k] = tb.mdd;
+      sr[k] = std::min(tb.sw, across);
       Q[k] = L * mdd[k];
     }
   }
@@ -242,7 +252,7 @@ struct BoxDistance {
   double affine_curvature(int f) const { return s0 * Q[f >> 1]; }
   // The turn's part of |d_f'|: |w x u| lever s_max (a top that is not spherical: |w x u| <=
   // max |w(t)|; turn_bounds)
-  double turn_rate_bound(int f) const { return sw[f >> 1] * lever * smax; }
+  double turn_rate_bound(int f) const { return sr[f >> 1] * lever * smax; }
   // |d_f'| <= K_f
   double rate_bound(int f) const {
     return std::abs(st.v.dot(axes.col(f >> 1))) + turn_rate_bound(f) + std::abs(sdot) * L;
@@ -260,7 +270,7 @@ struct BoxDistance {
 template <SupportShape S>
 EscapeResult escape_time(const EscapeInput<S>& in, const EscapeOptions& o = {}) {
   const BoxDistance<S> D(in.shape, in.body, in.t_state, in.box, in.margin, in.scale,
-                         in.scale_rate, in.t_max);
+                         in.scale_rate, in.t_max, in.revolution);
   const FirstRoot r = first_root(D, in.t_start, in.t_max, in.eps, o);
   EscapeResult out;
   out.status = r.status == RootStatus::found  ? EscapeStatus::escapes

@@ -230,6 +230,7 @@ class ObbNeighbors {
       const AnyShape shape = sc == 1.0 ? kind.shape : resized(kind.shape, sc);
       return escape_event(e, now, t_cap, std::visit([&](const auto& x) {
         EscapeInput<std::decay_t<decltype(x)>> in{x, b, s.t[i], now, t_cap, box_near(i, b.r), margin, margin};
+        in.revolution = revolution_;
         return escape_time(in, escape_options(margin));
       }, shape));
     } else {
@@ -237,6 +238,7 @@ class ObbNeighbors {
       if (K == 0.0) return e;  // at rest: never leaves
       const double t_cap = now + 8.0 * rc_ / K;
       EscapeInput<S> in{shape_, b, s.t[i], now, t_cap, box_near(i, b.r), margin_, eps_};
+      in.revolution = revolution_;
       return escape_event(e, now, t_cap, escape_time(in, escape_options(margin_)));
     }
   }
@@ -314,6 +316,9 @@ class ObbNeighbors {
   // to the SAT.
   void set_capsule_test(bool on) { capsules_ = on; }
   bool capsule_test() const { return capsules_; }
+  // Escape searches of bodies of revolution bounded by the spin across the axis (EscapeInput::
+  // revolution; false: by |w|, the slow twin).
+  void set_revolution_bounds(bool on) { revolution_ = on; }
 
  private:
   // A box is elongated when its longest half-extent exceeds the others by 20 % (the capsule
@@ -510,6 +515,7 @@ class ObbNeighbors {
   std::vector<std::pair<std::uint32_t, Vec3>> near_;  // link's candidates (scratch)
   AdjacencyLists lists_;
   bool capsules_ = false;     // the capsule test ahead of obb_overlap (set_capsule_test)
+  bool revolution_ = true;    // set_revolution_bounds
   ObbCore core_;             // one shape: every box's core (the capsule test)
   std::uint64_t rebuilds_ = 0;
   mutable std::uint64_t truncated_ = 0;

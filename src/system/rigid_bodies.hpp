@@ -223,9 +223,13 @@ template <class SA, class SB>
 double memo_or_centres_clear_time(const SA& A, const SB& B, const State& s, std::uint32_t i,
                                   const BodyState& a, const RotationFrame& fa, std::uint32_t j,
                                   const Vec3& c, double now, double horizon,
-                                  const AxisMemo& memo) {
+                                  const AxisMemo& memo, bool revolution = true) {
   const Vec3 dv = s.v[j] - a.v;
-  const SpinBound wa = spin_bound(a), wb = spin_bound(s, j);
+  SpinBound wa = spin_bound(a), wb = spin_bound(s, j);
+  if (revolution) {  // bodies of revolution: the spin across their axes (SpinBound::across)
+    wa.across = spin_across_of(A, a.q, a.w, a.top);
+    wb.across = spin_across_of(B, s.q[j], s.w[j], s.top(j));
+  }
   const double age = now - s.t[j], span = horizon - now;
   Vec3 u;
   if (memo.find_either(i, j, u))
@@ -478,7 +482,8 @@ struct RigidBodies {
                            const RotationFrame& fa, std::uint32_t j, const Vec3& c, double now,
                            double horizon) const {
     return centre_line_test
-               ? memo_or_centres_clear_time(shape, shape, s, i, a, fa, j, c, now, horizon, memo)
+               ? memo_or_centres_clear_time(shape, shape, s, i, a, fa, j, c, now, horizon, memo,
+                                            options.revolution_bounds)
                : 0.0;
   }
   // The radius of contact_time's bounding-sphere test for two bodies of this shape at scale 1

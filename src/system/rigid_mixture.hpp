@@ -157,7 +157,8 @@ struct RigidMixture {
     }
     return std::visit(
         [&](const auto& A, const auto& B) {
-          return memo_or_centres_clear_time(A, B, s, i, a, fa, j, c, now, horizon, memo);
+          return memo_or_centres_clear_time(A, B, s, i, a, fa, j, c, now, horizon, memo,
+                                            options.revolution_bounds);
         },
         sa, *sb);
   }
