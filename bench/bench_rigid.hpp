@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "setup/builder.hpp"
+#include "shapes/inertia.hpp"
 
 #include "bench_common.hpp"
 
@@ -68,9 +69,10 @@ struct RigidPoint {
   double x0 = 2.0;
   double p = 2.0;
   double shell = 0.15;
+  bool revolution = true;  // the spheroids' spin-across bounds (false: the slow twin's |w|)
 };
 
-// Reads shape, N, phi, X0, b, p, inertia, eps_d, seed, method, shell.  Defaults: the
+// Reads shape, N, phi, X0, b, p, inertia, revolution, eps_d, seed, method, shell.  Defaults: the
 // ellipsoids of bench_ellipsoids (b = 1/2, I = 2/5 m (smallest semi-axis)^2).
 inline RigidPoint read_point(Args& a) {
   RigidPoint pt;
@@ -86,7 +88,17 @@ inline RigidPoint read_point(Args& a) {
   pt.p = a.num("p", 2.0);
   pt.spec.semi_axes = Vec3(pt.x0 * b, b, b);
   pt.spec.exponents = Vec3(2.0, 2.0, pt.p);
-  pt.spec.inertia = Vec3::Constant(a.num("inertia", 0.4 * pt.spec.mass * hb::sqr(pt.spec.semi_axes.minCoeff())));
+  // inertia: a number (a spherical top) or "solid" (the uniform solid's principal moments)
+  if (a.str("inertia", "") == "solid") {
+    pt.spec.inertia = pt.shape == "ellipsoid"
+                          ? hb::uniform_inertia(hb::Ellipsoid{pt.spec.semi_axes.x(), pt.spec.semi_axes.y(),
+                                                              pt.spec.semi_axes.z()},
+                                                pt.spec.mass)
+                          : hb::uniform_inertia(hb::superquadric_shape(pt.spec), pt.spec.mass);
+  } else {
+    pt.spec.inertia = Vec3::Constant(a.num("inertia", 0.4 * pt.spec.mass * hb::sqr(pt.spec.semi_axes.minCoeff())));
+  }
+  pt.revolution = a.num("revolution", 1) != 0;
   pt.spec.eps_d = a.num("eps_d", 1e-5);
   pt.spec.seed = static_cast<std::uint64_t>(a.num("seed", 1));
   pt.shell = a.num("shell", 0.15);
@@ -333,7 +345,14 @@ inline Start lattice_start_of(const RigidPoint& pt) {
 // Builds the simulation of a rigid point from `st` and hands it to f (a generic lambda).
 template <class F>
 void with_rigid_simulation(const RigidPoint& pt, Start st, F&& f) {
-  with_rigid_assembly(config_of(pt), [&](const auto& as) { f(as.simulate(st.box, std::move(st.state), st.now)); });
+  with_rigid_assembly(config_of(pt), [&](const auto& as) {
+    auto sim = as.simulate(st.box, std::move(st.state), st.now);
+    if constexpr (requires { sim.model().options.revolution_bounds; })
+      sim.model().options.revolution_bounds = pt.revolution;
+    if constexpr (requires { sim.neighbors().set_revolution_bounds(true); })
+      sim.neighbors().set_revolution_bounds(pt.revolution);
+    f(std::move(sim));
+  });
 }
 
 // main() of a benchmark: bad arguments and unexpected errors exit with status 2 and one message.
@@ -355,7 +374,9 @@ inline Json describe(const RigidPoint& pt) {
   j["p"] = pt.p;
   j["semi_axes"] = {pt.spec.semi_axes.x(), pt.spec.semi_axes.y(), pt.spec.semi_axes.z()};
   j["exponents"] = {pt.spec.exponents.x(), pt.spec.exponents.y(), pt.spec.exponents.z()};
-  j["inertia"] = pt.spec.inertia.x();
+  if (hb::spherical_top(pt.spec.inertia)) j["inertia"] = pt.spec.inertia.x();
+  else j["inertia"] = {pt.spec.inertia.x(), pt.spec.inertia.y(), pt.spec.inertia.z()};
+  j["revolution"] = pt.revolution;
   j["method"] = pt.method;
   j["shell"] = pt.shell;
   j["eps_d"] = pt.spec.eps_d;

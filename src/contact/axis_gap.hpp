@@ -450,11 +450,12 @@ struct SpinBound {
   double across = kInf;
 };
 // SpinBound::across of a body of shape `sh` from its stored orientation, angular velocity and
-// principal moments (kInf unless a body of revolution whose spin across the axis is constant).
+// principal moments, wmax a bound of |w| (kInf unless a body of revolution whose spin across
+// the axis is constant).
 template <Shape S>
-double spin_across_of(const S& sh, const Quat& q, const Vec3& w, const Vec3& top) {
+double spin_across_of(const S& sh, const Quat& q, const Vec3& w, const Vec3& top, double wmax) {
   const int k = revolution_axis(sh);
-  return k < 0 ? kInf : spin_across_bound(q, w, top, k);
+  return k < 0 ? kInf : spin_across_bound(q, w, top, k, wmax);
 }
 // Body A's rotation for a run of axis tests against many candidates (one prediction,
 // system/rigid_bodies.hpp): its matrix, formed once; a direction then turns into A's frame and

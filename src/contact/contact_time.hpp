@@ -215,8 +215,9 @@ struct ContactOptions {
   // solve from the axis' touching guess, the slow twin).
   bool touch_from_memo = true;
   // Rate bounds of bodies of revolution (shapes/shape.hpp revolution_axis) from the spin across
-  // their axes, Motion::spin_across: in K, the axis gaps' K_n and the rigid models' pre-filters
-  // (SpinBound::across; false: from |w|, the slow twin).
+  // their axes, Motion::spin_across, in K and the axis gaps' K_n, and in the rigid models'
+  // pre-filters for tops that are not spherical (SpinBound::across, system/rigid_bodies.hpp)
+  // (false: from |w|, the slow twin).
   bool revolution_bounds = true;
   DistanceOptions distance{};
 };

@@ -52,8 +52,12 @@ struct Ellipsoid {
   // values at the ends of the range).
   double rotation_lever() const { return max_ - min_; }
   // A spheroid (two equal semi-axes) is a body of revolution about its third axis
-  // (shapes/shape.hpp); a sphere has no rotation lever, so it needs none.
-  int revolution_axis() const { return b == c ? 0 : a == c ? 1 : a == b ? 2 : -1; }
+  // (shapes/shape.hpp). A sphere declares none: its rotation lever is 0, so it would gain
+  // nothing for the bound's cost.
+  int revolution_axis() const {
+    if (a == b && b == c) return -1;
+    return b == c ? 0 : a == c ? 1 : a == b ? 2 : -1;
+  }
   Vec3 half_extents() const { return Vec3(a, b, c); }
   Vec3 ray_surface(const Vec3& u) const {
     return u / std::sqrt(u.cwiseProduct(u).dot(inv_sq()));

@@ -226,9 +226,13 @@ double memo_or_centres_clear_time(const SA& A, const SB& B, const State& s, std:
                                   const AxisMemo& memo, bool revolution = true) {
   const Vec3 dv = s.v[j] - a.v;
   SpinBound wa = spin_bound(a), wb = spin_bound(s, j);
-  if (revolution) {  // bodies of revolution: the spin across their axes (SpinBound::across)
-    wa.across = spin_across_of(A, a.q, a.w, a.top);
-    wb.across = spin_across_of(B, s.q[j], s.w[j], s.top(j));
+  // Tops that are not spherical turn at up to wmax in every direction; a symmetric top of
+  // revolution about its own axis moves its surface at its spin across that axis only, often
+  // far less (SpinBound::across). Spherical tops keep |w x u|: at X0 = 10 with isotropic
+  // inertia the bound cost more than it saved (docs/benchmarks/README.md, 2026-12-04).
+  if (revolution) {
+    if (wa.wmax >= 0.0) wa.across = spin_across_of(A, a.q, a.w, a.top, wa.wmax);
+    if (wb.wmax >= 0.0) wb.across = spin_across_of(B, s.q[j], s.w[j], s.top(j), wb.wmax);
   }
   const double age = now - s.t[j], span = horizon - now;
   Vec3 u;

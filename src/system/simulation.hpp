@@ -145,6 +145,8 @@ class Simulation {
   const Model& model() const { return model_; }
   Model& model() { return model_; }
   const Neighbors& neighbors() const { return nb_; }
+  // For settings between events that leave the lists valid (e.g. the slow twins' switches).
+  Neighbors& neighbors() { return nb_; }
   const BodyEvents& body_events() const { return events_; }
   const std::array<std::uint64_t, kEventTypes>& event_counts() const { return counts_; }
   std::uint64_t stale_events() const { return stale_; }

@@ -757,8 +757,8 @@ TEST(AxisGap, ClearTimeOfBodiesOfRevolutionIsBelowTheGap) {
     };
     SpinBound sa = spin(ma), sb = spin(mb);
     const SpinBound plain_a = sa, plain_b = sb;
-    sa.across = spin_across_of(p.a, qa, wa, p.sa.top);
-    sb.across = spin_across_of(p.b, p.sb.q, p.sb.w, p.sb.top);
+    sa.across = spin_across_of(p.a, qa, wa, p.sa.top, ma.max_angular_speed());
+    sb.across = spin_across_of(p.b, p.sb.q, p.sb.w, p.sb.top, mb.max_angular_speed());
     for (const bool second : {false, true}) {
       const double tc = axis_clear_time(p.a, qa, wa, p.b, p.sb.q, p.sb.w, c, u, dv, age, kInf,
                                         sa, sb, second);

@@ -116,7 +116,9 @@ TEST(Contact, DistanceRateBoundWithRotationLeversHolds) {
     ASSERT_LE(std::abs(rate), K_rev * (1 + 1e-6) + 1e-9) << "case " << k;
     ASSERT_LE(K, K_paper);
     ASSERT_LE(K_rev, K);
-    if (revolution_axis(sa) < 0 && revolution_axis(sb) < 0) ASSERT_EQ(K_rev, K);
+    if (revolution_axis(sa) < 0 && revolution_axis(sb) < 0) {
+      ASSERT_EQ(K_rev, K);
+    }
     worst = std::max(worst, std::abs(rate) / K);
     if (spin_only) worst_spin = std::max(worst_spin, std::abs(rate) / K);
     if (spin_only) worst_rev = std::max(worst_rev, std::abs(rate) / K_rev);
