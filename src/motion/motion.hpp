@@ -41,12 +41,6 @@ inline double angular_acceleration_bound(const Vec3& top, double wmax) {
   return c * wmax * wmax / std::sqrt(3.0);
 }
 
-// Motion::spin_across's bound from a body's orientation q, lab angular velocity w and principal
-// moments `top` at any one time of its flight: |w x e_k| (e_k = q's column k) for a spherical
-// top or a symmetric top about k (constant along the flight; see there), times (1 + 1e-14)
-// plus 1e-14 wmax (a bound of |w|), a margin for the rounding of e_k and of the poses along the flight (a spin
-// nearly along the axis leaves a small cross product of large vectors); kInf for other tops
-// (no bound beyond |w|'s).
 // Column k of the rotation matrix of the unit quaternion q: the body axis k in the lab.
 inline Vec3 body_axis(const Quat& q, int k) {
   const double x = q.x(), y = q.y(), z = q.z(), s = q.w();
@@ -54,6 +48,12 @@ inline Vec3 body_axis(const Quat& q, int k) {
   if (k == 1) return Vec3(2.0 * (x * y - s * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z + s * x));
   return Vec3(2.0 * (x * z + s * y), 2.0 * (y * z - s * x), 1.0 - 2.0 * (x * x + y * y));
 }
+// Motion::spin_across's bound from a body's orientation q, lab angular velocity w and principal
+// moments `top` at any one time of its flight: |w x e_k| (e_k = q's column k) for a spherical
+// top or a symmetric top about k (constant along the flight; see there), times (1 + 1e-14)
+// plus 1e-14 wmax (wmax a bound of |w|), a margin for the rounding of e_k and of the poses
+// along the flight (a spin nearly along the axis leaves a small cross product of large
+// vectors); kInf for other tops (no bound beyond |w|'s).
 inline double spin_across_bound(const Quat& q, const Vec3& w, const Vec3& top, int k, double wmax) {
   if (!spherical_top(top) && top[(k + 1) % 3] != top[(k + 2) % 3]) return kInf;
   return w.cross(body_axis(q, k)).norm() * (1.0 + 1e-14) + 1e-14 * wmax;
