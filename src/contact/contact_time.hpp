@@ -345,13 +345,9 @@ void contact_system(const MovingBody<SA>& A, const MovingBody<SB>& B, const Vec5
 inline double distance_rate_bound(const BodyState& a, double la, const BodyState& b, double lb) {
   return (b.v - a.v).norm() + a.w.norm() * la + b.w.norm() * lb;
 }
-// The same for any tops: |w(t)| <= max_angular_speed() (equal to |w| for spherical tops).
-inline double distance_rate_bound(const Motion& a, double la, const Motion& b, double lb) {
-  return (b.initial().v - a.initial().v).norm() + a.max_angular_speed() * la +
-         b.max_angular_speed() * lb;
-}
-// The same with the shapes' axes of revolution ka, kb (shapes/shape.hpp revolution_axis; -1:
-// none): only the part of w across that axis moves the surface, |w x e| <= spin_across(k).
+// The same for any tops, |w(t)| <= max_angular_speed() (equal to |w| for spherical tops), with
+// the shapes' axes of revolution ka, kb (shapes/shape.hpp revolution_axis; -1: none, |w|): only
+// the part of w across that axis moves the surface, |w x e| <= spin_across(k).
 inline double distance_rate_bound(const Motion& a, double la, int ka, const Motion& b, double lb,
                                   int kb) {
   return (b.initial().v - a.initial().v).norm() + a.spin_across(ka) * la + b.spin_across(kb) * lb;
