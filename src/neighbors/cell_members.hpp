@@ -38,10 +38,19 @@ class CellMembers {
     Vec3 centre() const { return Vec3(x, y, z); }
   };
 
+  // Half-extents of the axis-aligned box around a member's body (single precision, rounded
+  // up; inf: none given), kept beside the members (same slots) and read only by the walk with
+  // boxes (for_each_within_box).
+  struct Half {
+    float x, y, z, pad;
+    Vec3 value() const { return Vec3(x, y, z); }
+  };
+
   void init(std::size_t n_cells, std::size_t n_bodies) {
     const double mean = n_cells > 0 ? double(n_bodies) / double(n_cells) : 0.0;
     cap_ = static_cast<std::uint32_t>(std::ceil(2.0 * mean)) + 8;
     data_.assign(n_cells * cap_, Member{});
+    half_.assign(n_cells * cap_, Half{});
     size_.assign(n_cells, 0);
     max_abs_ = 0.0;
   }
@@ -49,18 +58,27 @@ class CellMembers {
   const Member* begin(std::uint32_t cell) const { return data_.data() + std::size_t(cell) * cap_; }
   const Member* end(std::uint32_t cell) const { return begin(cell) + size_[cell]; }
 
-  void insert(std::uint32_t cell, std::uint32_t id, const Vec3& c) {
+  const Half& half(const Member* m) const { return half_[std::size_t(m - data_.data())]; }
+
+  // A member at centre c whose body lies within the axis-aligned box c +- half (default: none,
+  // the box test passes it).
+  void insert(std::uint32_t cell, std::uint32_t id, const Vec3& c,
+              const Vec3& half = Vec3::Constant(kInf)) {
     if (size_[cell] == cap_) grow();
     max_abs_ = std::max(max_abs_, c.cwiseAbs().maxCoeff());
-    data_[std::size_t(cell) * cap_ + size_[cell]++] =
-        Member{float(c.x()), float(c.y()), float(c.z()), id};
+    const std::size_t slot = std::size_t(cell) * cap_ + size_[cell]++;
+    data_[slot] = Member{float(c.x()), float(c.y()), float(c.z()), id};
+    half_[slot] = Half{up(half.x()), up(half.y()), up(half.z()), 0.0f};
   }
   void remove(std::uint32_t cell, std::uint32_t id) {
-    Member* b = data_.data() + std::size_t(cell) * cap_;
+    const std::size_t first = std::size_t(cell) * cap_, last = first + size_[cell] - 1;
+    Member* b = data_.data() + first;
     Member* e = b + size_[cell];
     Member* p = std::find_if(b, e, [id](const Member& m) { return m.id == id; });
     if (p == e) throw std::logic_error("cell members: body not in its cell");
-    *p = e[-1];
+    const std::size_t at = std::size_t(p - data_.data());
+    data_[at] = data_[last];
+    half_[at] = half_[last];
     --size_[cell];
   }
   // Calls fn(id) for the members of `cell` whose centres are within `reach` of `from`, the
@@ -78,15 +96,48 @@ class CellMembers {
   template <class Fn>
   [[gnu::always_inline]] void for_each_within(std::uint32_t cell, const Vec3& from, const Vec3& period, double reach,
                        Fn&& fn) const {
+    walk<false>(cell, from, period, reach, Vec3::Constant(kInf), fn);
+  }
+  // The same, and besides only the members whose axis-aligned boxes overlap the caller's
+  // (its body within from +- half) along every axis: the folded separation at most half + the
+  // member's half, widened as the distance is (1e-5 S). For elongated or flat bodies, whose
+  // boxes are thin across some axis where the bodies are aligned (ObbNeighbors::link). It reads
+  // the members' half-extents beside their records (16 bytes more a member walked).
+  template <class Fn>
+  [[gnu::always_inline]] void for_each_within_box(std::uint32_t cell, const Vec3& from, const Vec3& period,
+                                                  double reach, const Vec3& half, Fn&& fn) const {
+    walk<true>(cell, from, period, reach, half, fn);
+  }
+
+  // A bound on |m.centre() - c| for every member inserted at centre c: sqrt(3) 2^-24 times the
+  // largest coordinate inserted, doubled, plus 1e-44 (a coordinate below float's normal range
+  // is rounded to within 2^-150 absolute).
+  double rounding_bound() const {
+    return 2.0 * 1.7320508075688772 * std::ldexp(max_abs_, -24) + 1e-44;
+  }
+  // x >= 0 rounded up to single precision (inf stays inf): float(x) rounds to nearest, within
+  // half an ulp; one ulp more (the product by 1 + 2^-23 rounds to at least that) is above x.
+  static float up(double x) {
+    const float f = static_cast<float>(x);
+    return double(f) >= x ? f : f * (1.0f + 0x1p-23f);
+  }
+
+ private:
+  template <bool kBoxes, class Fn>
+  [[gnu::always_inline]] void walk(std::uint32_t cell, const Vec3& from, const Vec3& period, double reach,
+                                   const Vec3& half, Fn& fn) const {
     using F4 = float __attribute__((vector_size(16)));
     using I4 = std::int32_t __attribute__((vector_size(16)));
     static_assert(sizeof(Member) == sizeof(F4), "a member is one vector of four lanes");
+    static_assert(sizeof(Half) == sizeof(F4), "a member's half-extents are one vector of four lanes");
     double scale = max_abs_ + from.cwiseAbs().maxCoeff() + reach, pmax = 0.0;
     for (int k = 0; k < 3; ++k)
       if (std::isfinite(period[k])) pmax = std::max(pmax, period[k]);
     const double r = reach + 1e-5 * (scale + pmax);
     const float r2 = std::nextafter(static_cast<float>(r * r), std::numeric_limits<float>::infinity());
     const F4 f = {float(from[0]), float(from[1]), float(from[2]), 0.0f};
+    const double slack = 1e-5 * (scale + pmax);  // the distance's widening, along each axis
+    const F4 hq = {up(half[0] + slack), up(half[1] + slack), up(half[2] + slack), 0.0f};
     const F4 p = {float(period[0]), float(period[1]), float(period[2]), 0.0f};  // kInf: inf
     const I4 centre = {-1, -1, -1, 0};                               // the fourth lane is the id
     const I4 magnitude = {0x7fffffff, 0x7fffffff, 0x7fffffff, 0};  // |x|
@@ -106,30 +157,37 @@ class CellMembers {
         const F4 x = a < q ? a : q;
         const F4 x2 = x * x;
         pass[n] = m->id;
-        n += x2[0] + x2[1] + x2[2] <= r2;
+        if constexpr (kBoxes) {
+          F4 hm;
+          std::memcpy(&hm, &half_[std::size_t(m - data_.data())], sizeof hm);
+          // apart along an axis (lane 3: 0 > 0, never); the three lanes or-ed into lane 0
+          I4 apart = x > hq + hm;
+          apart |= __builtin_shufflevector(apart, apart, 1, 2, 0, 3);
+          apart |= __builtin_shufflevector(apart, apart, 2, 0, 1, 3);
+          n += (x2[0] + x2[1] + x2[2] <= r2) & (apart[0] == 0);
+        } else {
+          n += x2[0] + x2[1] + x2[2] <= r2;
+        }
       }
       for (int k = 0; k < n; ++k) fn(pass[k]);
     }
   }
 
-  // A bound on |m.centre() - c| for every member inserted at centre c: sqrt(3) 2^-24 times the
-  // largest coordinate inserted, doubled, plus 1e-44 (a coordinate below float's normal range
-  // is rounded to within 2^-150 absolute).
-  double rounding_bound() const {
-    return 2.0 * 1.7320508075688772 * std::ldexp(max_abs_, -24) + 1e-44;
-  }
-
- private:
   void grow() {
     const std::uint32_t cap = 2 * cap_;
     std::vector<Member> d(size_.size() * cap);
-    for (std::size_t c = 0; c < size_.size(); ++c)
+    std::vector<Half> h(size_.size() * cap);
+    for (std::size_t c = 0; c < size_.size(); ++c) {
       std::copy_n(data_.begin() + c * cap_, size_[c], d.begin() + c * cap);
+      std::copy_n(half_.begin() + c * cap_, size_[c], h.begin() + c * cap);
+    }
     data_.swap(d);
+    half_.swap(h);
     cap_ = cap;
   }
   std::uint32_t cap_ = 8;
   std::vector<Member> data_;
+  std::vector<Half> half_;  // beside data_, slot for slot
   std::vector<std::uint32_t> size_;
   double max_abs_ = 0.0;
 };

@@ -123,6 +123,7 @@ class ObbNeighbors {
     rc_ = (ext_.array() + shell_).matrix().norm();
     kbound_l_ = shape.bounding_radius();
     capsules_ = elongated(Vec3(ext_.array() + shell_));
+    boxes_ = anisotropic(Vec3(ext_.array() + shell_));
     core_ = obb_core(Vec3(ext_.array() + shell_));
   }
   // A mixture: body i is species_shapes[species_i] resized by scale_i <= max_scale[species_i].
@@ -140,6 +141,7 @@ class ObbNeighbors {
       kinds_.push_back(kind);
       rc_ = std::max(rc_, (kind.ext.array() * max_scale[k] + shell_).matrix().norm());
       capsules_ = capsules_ || elongated(Vec3(kind.ext.array() + shell_));
+      boxes_ = boxes_ || anisotropic(Vec3(kind.ext.array() + shell_));
     }
   }
 
@@ -316,6 +318,10 @@ class ObbNeighbors {
   // to the SAT.
   void set_capsule_test(bool on) { capsules_ = on; }
   bool capsule_test() const { return capsules_; }
+  // The axis-aligned box test in link's walk (on by default for anisotropic boxes; off: the
+  // circumspheres only, the slow twin).
+  void set_box_test(bool on) { boxes_ = on; }
+  bool box_test() const { return boxes_; }
   // Escape searches of bodies of revolution bounded by the spin across the axis (EscapeInput::
   // revolution; false: by |w|, the slow twin).
   void set_revolution_bounds(bool on) { revolution_ = on; }
@@ -323,6 +329,10 @@ class ObbNeighbors {
  private:
   // A box is elongated when its longest half-extent exceeds the others by 20 % (the capsule
   // around its long axis is then narrower than its circumsphere by a useful margin).
+  // A box is anisotropic when its longest half-extent exceeds its shortest by 20 %: aligned
+  // bodies then have axis-aligned boxes thinner than their circumspheres along some axis
+  // (link's box test, CellMembers::for_each_within_box).
+  static bool anisotropic(const Vec3& h) { return h.maxCoeff() > 1.2 * h.minCoeff(); }
   static bool elongated(const Vec3& h) {
     const CoreSegment c = core_segment(h);  // its long axis and the second largest extent
     return h[c.axis] > 1.2 * c.thick;
@@ -441,8 +451,11 @@ class ObbNeighbors {
   // Body i into the cell of its box centre.
   void place(std::uint32_t i) {
     cells_.insert(i, obb_[i].centre);
-    members_.insert(cells_.cell_of(i), i, obb_[i].centre);
+    members_.insert(cells_.cell_of(i), i, obb_[i].centre, aabb_half(obb_[i]));
   }
+  // Half-extents of the axis-aligned box around an oriented one: sum_m |A_km| half_m along
+  // lab axis k (the box's corners' extreme coordinates).
+  static Vec3 aabb_half(const Obb& b) { return b.axes.cwiseAbs() * b.half; }
   void build_all(const Box& box) {
     for (std::uint32_t i = 0; i < obb_.size(); ++i) link(i, box, [i](std::uint32_t j) { return j > i; });
   }
@@ -473,13 +486,17 @@ class ObbNeighbors {
     if (image)
       for (int k = 0; k < 3; ++k)
         if (box.periodic[k]) fold[k] = box.L[k];
+    // i's axis-aligned box, widened like the reach by the centres' rounding (boxes_)
+    const Vec3 half = (aabb_half(obb_[i]).array() + members_.rounding_bound()).matrix();
     cells_.for_each_stencil_cell(i, box.L, [&](std::uint32_t c, const Vec3& shift) {
-      // j's centre minus ci - shift: the centre separation
-      members_.for_each_within(c, Vec3(ci - shift), fold, reach, [&](std::uint32_t j) {
+      auto keep = [&](std::uint32_t j) {
         if (!take(j)) return;
         __builtin_prefetch(&obb_[j]);
         near_.push_back({j, shift});
-      });
+      };
+      // j's centre minus ci - shift: the centre separation
+      if (boxes_) members_.for_each_within_box(c, Vec3(ci - shift), fold, reach, half, keep);
+      else members_.for_each_within(c, Vec3(ci - shift), fold, reach, keep);
     });
     for (const auto& [j, shift] : near_) {
       const Vec3 d = obb_[j].centre + shift - ci;
@@ -516,6 +533,7 @@ class ObbNeighbors {
   AdjacencyLists lists_;
   bool capsules_ = false;     // the capsule test ahead of obb_overlap (set_capsule_test)
   bool revolution_ = true;    // set_revolution_bounds
+  bool boxes_ = false;        // the axis-aligned box test in link's walk (set_box_test)
   ObbCore core_;             // one shape: every box's core (the capsule test)
   std::uint64_t rebuilds_ = 0;
   mutable std::uint64_t truncated_ = 0;

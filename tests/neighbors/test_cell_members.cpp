@@ -1,12 +1,14 @@
 // CellMembers (neighbors/cell_members.hpp) against a CellList's own linked cells, its slow twin:
 // after random moves between cells (with overflows that grow the capacity), every cell holds the
-// same bodies, each member's centre is its body's to within rounding_bound(), and the stencil
+// same bodies, each member's centre is its body's to within rounding_bound() (and its box
+// half-extents its body's, rounded up), and the stencil
 // walk of CellList::for_each_stencil_cell over the members finds the bodies, with their image
 // shifts, that CellList::for_each_neighbor finds; and the walk's distance test
 // (for_each_within) against double precision.
 #include <gtest/gtest.h>
 
 #include <pcg_random.hpp>
+#include <cstdio>
 #include <random>
 #include <set>
 #include <tuple>
@@ -30,10 +32,12 @@ TEST(CellMembers, HoldWhatTheLinkedCellsHold) {
   CellMembers members;
   members.init(cells.n_cells(), n);
   std::vector<Vec3> r(n);
+  // each body's box half-extents, which must follow it through the moves into holes and growth
+  auto half_of = [](std::uint32_t i) { return Vec3(0.1 + 1e-3 * i, 0.3 + 7e-4 * i, 0.2 + 3e-4 * i); };
   auto put = [&](std::uint32_t i, const Vec3& x) {
     r[i] = x;
     cells.insert(i, x);
-    members.insert(cells.cell_of(i), i, x);
+    members.insert(cells.cell_of(i), i, x, half_of(i));
   };
   for (std::uint32_t i = 0; i < n; ++i) put(i, Vec3(u(rng) * box.L.x(), u(rng) * box.L.y(), u(rng) * box.L.z()));
   std::uniform_int_distribution<std::uint32_t> body(0, n - 1);
@@ -53,6 +57,11 @@ TEST(CellMembers, HoldWhatTheLinkedCellsHold) {
     for (const CellMembers::Member* m = members.begin(c); m != members.end(c); ++m) {
       packed.insert(m->id);
       EXPECT_LE((m->centre() - r[m->id]).norm(), members.rounding_bound());
+      const Vec3 h = members.half(m).value(), want = half_of(m->id);
+      for (int a = 0; a < 3; ++a) {  // rounded up to single precision
+        EXPECT_GE(h[a], want[a]) << "body " << m->id;
+        EXPECT_LE(h[a], want[a] * (1.0 + 2.5e-7)) << "body " << m->id;
+      }
     }
     EXPECT_EQ(packed, linked) << "cell " << c;
     EXPECT_EQ(members.size(c), linked.size());
@@ -138,4 +147,72 @@ TEST(CellMembers, WalkFindsTheMembersWithinReach) {
   }
   EXPECT_GT(reported, 400u);
   EXPECT_GT(near_cut, 200u);  // the cut-off was tried
+}
+
+// The walk's axis-aligned box test (for_each_within_box, members inserted with their
+// half-extents) against double precision on the stored centres and the extents as given, its
+// slow twin: a member is reported exactly once if it is within reach and its box overlaps the
+// query's along every axis (the separation folded once), and never if it is beyond reach or
+// apart along an axis by more than the documented widening. Boxes from needles to cubes,
+// members placed within 1e-7 of a box face on both sides; members inserted without extents
+// pass the box test.
+TEST(CellMembers, WalkSkipsTheMembersWhoseBoxesLieApart) {
+  pcg32 rng(31);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const Vec3 L(10.0, 8.0, 12.0);
+  const Vec3 period(L.x(), L.y(), kInf);
+  const double reach = 4.0;
+  std::size_t reported = 0, skipped_by_boxes = 0, near_face = 0;
+  auto extents = [&]() {  // a needle along a random axis, or a rounder box
+    Vec3 h(u(rng) * 0.6 + 0.05, u(rng) * 0.6 + 0.05, u(rng) * 0.6 + 0.05);
+    if (u(rng) < 0.5) h[static_cast<int>(u(rng) * 3) % 3] = 1.0 + u(rng);
+    return h;
+  };
+  for (int trial = 0; trial < 400; ++trial) {
+    CellMembers members;
+    members.init(1, 1);
+    const Vec3 from(u(rng) * L.x(), u(rng) * L.y(), u(rng) * L.z());
+    const Vec3 hq = extents();
+    const std::uint32_t n = 1 + trial % 70;
+    std::vector<Vec3> half(n, Vec3::Constant(kInf));
+    double max_abs = 0.0;
+    for (std::uint32_t k = 0; k < n; ++k) {
+      Vec3 c(u(rng) * L.x(), u(rng) * L.y(), u(rng) * L.z());
+      if (k % 7 != 6) half[k] = extents();  // every seventh without extents
+      if (k % 3 == 0 && k % 7 != 6) {  // on a box face along one axis, +-1e-7 (within reach)
+        const int a = static_cast<int>(u(rng) * 3) % 3;
+        c = from + Vec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5).cwiseProduct(hq + half[k]);
+        c[a] = from[a] + (u(rng) < 0.5 ? -1.0 : 1.0) * (hq[a] + half[k][a] + (u(rng) - 0.5) * 2e-7);
+        for (int b = 0; b < 2; ++b) c[b] -= L[b] * std::floor(c[b] / L[b]);
+      }
+      if (half[k].allFinite()) members.insert(0, k, c, half[k]);
+      else members.insert(0, k, c);
+      max_abs = std::max(max_abs, c.cwiseAbs().maxCoeff());
+    }
+    std::multiset<std::uint32_t> got;
+    members.for_each_within_box(0, from, period, reach, hq, [&](std::uint32_t j) { got.insert(j); });
+    const double S = max_abs + from.cwiseAbs().maxCoeff() + reach + L.head<2>().maxCoeff();
+    const double slack = 1e-5 * S + 1e-9;
+    for (const CellMembers::Member* m = members.begin(0); m != members.end(0); ++m) {
+      const std::uint32_t j = m->id;
+      Vec3 d = m->centre() - from;
+      for (int a = 0; a < 3; ++a) d[a] = std::min(std::abs(d[a]), period[a] - std::abs(d[a]));
+      const Vec3 gap = d - hq - half[j];  // > 0 along an axis: the boxes lie apart there
+      if (gap.cwiseAbs().minCoeff() < 1e-6) ++near_face;
+      if (d.norm() <= reach && gap.maxCoeff() <= 0.0) {
+        EXPECT_EQ(got.count(j), 1u) << "trial " << trial << " member " << j;
+      }
+      if (d.norm() > reach + slack || gap.maxCoeff() > slack) {
+        EXPECT_EQ(got.count(j), 0u) << "trial " << trial << " member " << j;
+      }
+      skipped_by_boxes += d.norm() <= reach && gap.maxCoeff() > slack;
+      EXPECT_LE(got.count(j), 1u);
+    }
+    reported += got.size();
+  }
+  std::printf("  %zu reported, %zu within reach skipped by the boxes, %zu near a box face\n",
+              reported, skipped_by_boxes, near_face);
+  EXPECT_GT(reported, 1000u);
+  EXPECT_GT(skipped_by_boxes, 1000u);
+  EXPECT_GT(near_face, 500u);
 }
