@@ -329,14 +329,14 @@ class ObbNeighbors {
  private:
   // A box is elongated when its longest half-extent exceeds the others by 20 % (the capsule
   // around its long axis is then narrower than its circumsphere by a useful margin).
-  // A box is anisotropic when its longest half-extent exceeds its shortest by 20 %: aligned
-  // bodies then have axis-aligned boxes thinner than their circumspheres along some axis
-  // (link's box test, CellMembers::for_each_within_box).
-  static bool anisotropic(const Vec3& h) { return h.maxCoeff() > 1.2 * h.minCoeff(); }
   static bool elongated(const Vec3& h) {
     const CoreSegment c = core_segment(h);  // its long axis and the second largest extent
     return h[c.axis] > 1.2 * c.thick;
   }
+  // A box is anisotropic when its longest half-extent exceeds its shortest by 20 %: aligned
+  // bodies then have axis-aligned boxes thinner than their circumspheres along some axis
+  // (link's box test, CellMembers::for_each_within_box).
+  static bool anisotropic(const Vec3& h) { return h.maxCoeff() > 1.2 * h.minCoeff(); }
   static void check_shell(double shell) {
     if (!(shell > 0.0)) throw std::invalid_argument("neighbour-list shell must be positive");
   }
