@@ -319,7 +319,8 @@ class ObbNeighbors {
   void set_capsule_test(bool on) { capsules_ = on; }
   bool capsule_test() const { return capsules_; }
   // The axis-aligned box test in link's walk (on by default for anisotropic boxes; off: the
-  // circumspheres only, the slow twin).
+  // circumspheres only, the slow twin). Set it before init: bodies placed while it is off keep
+  // no box (their members hold inf, which the test passes), so they would not be ruled out.
   void set_box_test(bool on) { boxes_ = on; }
   bool box_test() const { return boxes_; }
   // Escape searches of bodies of revolution bounded by the spin across the axis (EscapeInput::
@@ -448,10 +449,12 @@ class ObbNeighbors {
     obb_[i].axes = q.toRotationMatrix();
     obb_[i].half = half;
   }
-  // Body i into the cell of its box centre.
+  // Body i into the cell of its box centre, with its axis-aligned box when the box test is on
+  // (off: none, which isotropic boxes never read).
   void place(std::uint32_t i) {
     cells_.insert(i, obb_[i].centre);
-    members_.insert(cells_.cell_of(i), i, obb_[i].centre, aabb_half(obb_[i]));
+    if (boxes_) members_.insert(cells_.cell_of(i), i, obb_[i].centre, aabb_half(obb_[i]));
+    else members_.insert(cells_.cell_of(i), i, obb_[i].centre);
   }
   // Half-extents of the axis-aligned box around an oriented one: sum_m |A_km| half_m along
   // lab axis k (the box's corners' extreme coordinates).
@@ -486,8 +489,9 @@ class ObbNeighbors {
     if (image)
       for (int k = 0; k < 3; ++k)
         if (box.periodic[k]) fold[k] = box.L[k];
-    // i's axis-aligned box, widened like the reach by the centres' rounding (boxes_)
-    const Vec3 half = (aabb_half(obb_[i]).array() + members_.rounding_bound()).matrix();
+    // i's axis-aligned box, widened like the reach by the centres' rounding (boxes_ only)
+    const Vec3 half =
+        boxes_ ? Vec3(aabb_half(obb_[i]).array() + members_.rounding_bound()) : Vec3::Zero();
     cells_.for_each_stencil_cell(i, box.L, [&](std::uint32_t c, const Vec3& shift) {
       auto keep = [&](std::uint32_t j) {
         if (!take(j)) return;
