@@ -5,7 +5,8 @@
 //   shape=ellipsoid|superquadric  N=256  phi=0.5  X0=2  b=0.5  p=2  inertia=2/5 m min(a,b)^2
 //   (a number: a spherical top; solid: the uniform solid's principal moments)
 //   method=nnl|cells  shell=0.15  eps_d=1e-5  seed=1  revolution=1 (0: the spheroids' rate
-//   bounds from |w|, not from the spin across their axes: the slow twin)
+//   bounds from |w|, not from the spin across their axes: the slow twin)  box_test=1 (0: the
+//   neighbour lists' axis-aligned box pre-test off, where it would be on: the slow twin)
 //   collisions=5000  warmup=1000  warmup_per_particle=0 (warm-up at least this many times N)
 //   budget=inf (CPU s; stop measuring once spent, after at least
 //   min_collisions=500)  auto_n=0 (1: raise N until the lattice start reaches phi in a box of

@@ -70,9 +70,10 @@ struct RigidPoint {
   double p = 2.0;
   double shell = 0.15;
   bool revolution = true;  // the spheroids' spin-across bounds (false: the slow twin's |w|)
+  bool box_test = true;    // the NNL's axis-aligned box test where it is on (false: off, the twin)
 };
 
-// Reads shape, N, phi, X0, b, p, inertia, revolution, eps_d, seed, method, shell.  Defaults: the
+// Reads shape, N, phi, X0, b, p, inertia, revolution, box_test, eps_d, seed, method, shell.  Defaults: the
 // ellipsoids of bench_ellipsoids (b = 1/2, I = 2/5 m (smallest semi-axis)^2).
 inline RigidPoint read_point(Args& a) {
   RigidPoint pt;
@@ -99,6 +100,7 @@ inline RigidPoint read_point(Args& a) {
     pt.spec.inertia = Vec3::Constant(a.num("inertia", 0.4 * pt.spec.mass * hb::sqr(pt.spec.semi_axes.minCoeff())));
   }
   pt.revolution = a.num("revolution", 1) != 0;
+  pt.box_test = a.num("box_test", 1) != 0;
   pt.spec.eps_d = a.num("eps_d", 1e-5);
   pt.spec.seed = static_cast<std::uint64_t>(a.num("seed", 1));
   pt.shell = a.num("shell", 0.15);
@@ -351,6 +353,8 @@ void with_rigid_simulation(const RigidPoint& pt, Start st, F&& f) {
       sim.model().options.revolution_bounds = pt.revolution;
     if constexpr (requires { sim.neighbors().set_revolution_bounds(true); })
       sim.neighbors().set_revolution_bounds(pt.revolution);
+    if constexpr (requires { sim.neighbors().set_box_test(false); })
+      if (!pt.box_test) sim.neighbors().set_box_test(false);  // off after init: nothing stale
     f(std::move(sim));
   });
 }
@@ -377,6 +381,7 @@ inline Json describe(const RigidPoint& pt) {
   if (hb::spherical_top(pt.spec.inertia)) j["inertia"] = pt.spec.inertia.x();
   else j["inertia"] = {pt.spec.inertia.x(), pt.spec.inertia.y(), pt.spec.inertia.z()};
   j["revolution"] = pt.revolution;
+  j["box_test"] = pt.box_test;
   j["method"] = pt.method;
   j["shell"] = pt.shell;
   j["eps_d"] = pt.spec.eps_d;
