@@ -73,8 +73,8 @@ struct RigidPoint {
   bool box_test = true;    // the NNL's axis-aligned box test where it is on (false: off, the twin)
 };
 
-// Reads shape, N, phi, X0, b, p, inertia, revolution, box_test, eps_d, seed, method, shell.  Defaults: the
-// ellipsoids of bench_ellipsoids (b = 1/2, I = 2/5 m (smallest semi-axis)^2).
+// Reads shape, N, phi, X0, b, p, inertia, revolution, box_test, eps_d, seed, method, shell.
+// Defaults: the ellipsoids of bench_ellipsoids (b = 1/2, I = 2/5 m (smallest semi-axis)^2).
 inline RigidPoint read_point(Args& a) {
   RigidPoint pt;
   pt.shape = a.str("shape", "ellipsoid");
