@@ -319,8 +319,9 @@ class ObbNeighbors {
   void set_capsule_test(bool on) { capsules_ = on; }
   bool capsule_test() const { return capsules_; }
   // The axis-aligned box test in link's walk (on by default for anisotropic boxes; off: the
-  // circumspheres only, the slow twin). Set it before init: bodies placed while it is off keep
-  // no box (their members hold inf, which the test passes), so they would not be ruled out.
+  // circumspheres only, the slow twin). Off is safe at any time; on belongs before init:
+  // bodies placed while it is off keep no box (their members hold inf, which the test passes),
+  // so until their next rebuild they would not be ruled out (still correct, only slower).
   void set_box_test(bool on) { boxes_ = on; }
   bool box_test() const { return boxes_; }
   // Escape searches of bodies of revolution bounded by the spin across the axis (EscapeInput::
