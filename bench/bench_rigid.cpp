@@ -6,7 +6,9 @@
 //   (a number: a spherical top; solid: the uniform solid's principal moments)
 //   method=nnl|cells  shell=0.15  eps_d=1e-5  seed=1  revolution=1 (0: the spheroids' rate
 //   bounds from |w|, not from the spin across their axes: the slow twin)  box_test=1 (0: the
-//   neighbour lists' axis-aligned box pre-test off, where it would be on: the slow twin)
+//   neighbour lists' axis-aligned box pre-test off, where it would be on: the slow twin)  memo=1
+//   (0: no pair's last separating axis kept after the start, every search cold: the slow twin)
+//   shuffle=0 (1: the lattice start's bodies numbered at random, not along its Morton curve)
 //   collisions=5000  warmup=1000  warmup_per_particle=0 (warm-up at least this many times N)
 //   budget=inf (CPU s; stop measuring once spent, after at least
 //   min_collisions=500)  auto_n=0 (1: raise N until the lattice start reaches phi in a box of

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <map>
+#include <random>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -71,9 +72,12 @@ struct RigidPoint {
   double shell = 0.15;
   bool revolution = true;  // the spheroids' spin-across bounds (false: the slow twin's |w|)
   bool box_test = true;    // the NNL's axis-aligned box test where it is on (false: off, the twin)
+  bool memo = true;        // each pair's last separating axis kept (false: every search cold)
+  bool shuffle = false;    // bodies numbered at random, not along the lattice's Morton curve
 };
 
-// Reads shape, N, phi, X0, b, p, inertia, revolution, box_test, eps_d, seed, method, shell.
+// Reads shape, N, phi, X0, b, p, inertia, revolution, box_test, memo, shuffle, eps_d, seed,
+// method, shell.
 // Defaults: the ellipsoids of bench_ellipsoids (b = 1/2, I = 2/5 m (smallest semi-axis)^2).
 inline RigidPoint read_point(Args& a) {
   RigidPoint pt;
@@ -101,6 +105,8 @@ inline RigidPoint read_point(Args& a) {
   }
   pt.revolution = a.num("revolution", 1) != 0;
   pt.box_test = a.num("box_test", 1) != 0;
+  pt.memo = a.num("memo", 1) != 0;
+  pt.shuffle = a.num("shuffle", 0) != 0;
   pt.spec.eps_d = a.num("eps_d", 1e-5);
   pt.spec.seed = static_cast<std::uint64_t>(a.num("seed", 1));
   pt.shell = a.num("shell", 0.15);
@@ -341,6 +347,21 @@ inline Start lattice_start_of(const RigidPoint& pt) {
     st.box = s.box;
     st.state = std::move(s.state);
   });
+  if (pt.shuffle) {  // the same bodies, numbered in a random order (fixed seed)
+    const hb::State& a = st.state;
+    std::vector<std::size_t> perm(a.size());
+    for (std::size_t k = 0; k < perm.size(); ++k) perm[k] = k;
+    std::mt19937_64 g(pt.spec.seed);
+    std::shuffle(perm.begin(), perm.end(), g);
+    hb::State b = a;
+    for (std::size_t k = 0; k < perm.size(); ++k) {
+      const std::size_t m = perm[k];
+      b.r[k] = a.r[m], b.v[k] = a.v[m], b.q[k] = a.q[m], b.w[k] = a.w[m], b.t[k] = a.t[m];
+      b.count[k] = a.count[m], b.image[k] = a.image[m], b.species[k] = a.species[m];
+      b.scale[k] = a.scale[m];
+    }
+    st.state = std::move(b);
+  }
   return st;
 }
 
@@ -355,6 +376,7 @@ void with_rigid_simulation(const RigidPoint& pt, Start st, F&& f) {
       sim.neighbors().set_revolution_bounds(pt.revolution);
     if constexpr (requires { sim.neighbors().set_box_test(false); })
       if (!pt.box_test) sim.neighbors().set_box_test(false);  // off after init: nothing stale
+    if constexpr (requires { sim.model().memo.on; }) sim.model().memo.on = pt.memo;
     f(std::move(sim));
   });
 }
@@ -382,6 +404,8 @@ inline Json describe(const RigidPoint& pt) {
   else j["inertia"] = {pt.spec.inertia.x(), pt.spec.inertia.y(), pt.spec.inertia.z()};
   j["revolution"] = pt.revolution;
   j["box_test"] = pt.box_test;
+  j["memo"] = pt.memo;
+  j["shuffle"] = pt.shuffle;
   j["method"] = pt.method;
   j["shell"] = pt.shell;
   j["eps_d"] = pt.spec.eps_d;
