@@ -9,6 +9,8 @@
 //   neighbour lists' axis-aligned box pre-test off, where it would be on: the slow twin)  memo=1
 //   (0: no pair's last separating axis kept after the start, every search cold: the slow twin)
 //   shuffle=0 (1: the lattice start's bodies numbered at random, not along its Morton curve)
+//   resort=0 (1: where a scan rebuilds the simulation from the state the point before ended
+//   in, the bodies are renumbered along the Morton curve first)
 //   collisions=5000  warmup=1000  warmup_per_particle=0 (warm-up at least this many times N)
 //   budget=inf (CPU s; stop measuring once spent, after at least
 //   min_collisions=500)  auto_n=0 (1: raise N until the lattice start reaches phi in a box of
@@ -178,6 +180,7 @@ int run(int argc, char** argv) {
           j["reason"] = failure;
         }
       }
+      if (q.resort) st.state = morton_sorted(st.state, st.box);
     });
     std::printf("%s\n", j.dump().c_str());
     std::fflush(stdout);

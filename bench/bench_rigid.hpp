@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <map>
+#include <numeric>
 #include <random>
 #include <sstream>
 #include <stdexcept>
@@ -15,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "math/morton.hpp"
 #include "setup/builder.hpp"
 #include "shapes/inertia.hpp"
 
@@ -74,10 +76,11 @@ struct RigidPoint {
   bool box_test = true;    // the NNL's axis-aligned box test where it is on (false: off, the twin)
   bool memo = true;        // each pair's last separating axis kept (false: every search cold)
   bool shuffle = false;    // bodies numbered at random, not along the lattice's Morton curve
+  bool resort = false;     // a state carried over between simulations renumbered along a curve
 };
 
-// Reads shape, N, phi, X0, b, p, inertia, revolution, box_test, memo, shuffle, eps_d, seed,
-// method, shell.
+// Reads shape, N, phi, X0, b, p, inertia, revolution, box_test, memo, shuffle, resort, eps_d,
+// seed, method, shell.
 // Defaults: the ellipsoids of bench_ellipsoids (b = 1/2, I = 2/5 m (smallest semi-axis)^2).
 inline RigidPoint read_point(Args& a) {
   RigidPoint pt;
@@ -107,6 +110,7 @@ inline RigidPoint read_point(Args& a) {
   pt.box_test = a.num("box_test", 1) != 0;
   pt.memo = a.num("memo", 1) != 0;
   pt.shuffle = a.num("shuffle", 0) != 0;
+  pt.resort = a.num("resort", 0) != 0;
   pt.spec.eps_d = a.num("eps_d", 1e-5);
   pt.spec.seed = static_cast<std::uint64_t>(a.num("seed", 1));
   pt.shell = a.num("shell", 0.15);
@@ -340,6 +344,36 @@ void with_rigid_assembly(const hb::Config& c, F&& f) {
   });
 }
 
+// The same bodies in a new numbering: body k of the result is body perm[k] of a.
+inline hb::State renumbered(const hb::State& a, const std::vector<std::uint32_t>& perm) {
+  hb::State b = a;
+  for (std::size_t k = 0; k < perm.size(); ++k) {
+    const std::size_t m = perm[k];
+    b.r[k] = a.r[m], b.v[k] = a.v[m], b.q[k] = a.q[m], b.w[k] = a.w[m], b.t[k] = a.t[m];
+    b.count[k] = a.count[m], b.image[k] = a.image[m], b.species[k] = a.species[m];
+    b.scale[k] = a.scale[m];
+  }
+  return b;
+}
+// The bodies of a synchronized state numbered along the Morton curve of a grid of about one
+// cell per body (what the lattice start does at its start, and the hard-sphere loop does every
+// few N events): `resort=1` applies it where a simulation is rebuilt from a carried-over state,
+// to measure what the order lost over the run before costs.
+inline hb::State morton_sorted(const hb::State& s, const hb::Box& box) {
+  const std::size_t n = s.size();
+  const auto m = static_cast<std::uint32_t>(std::clamp(std::cbrt(double(n)), 1.0, double(1u << 20)));
+  std::vector<std::uint64_t> key(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint32_t c[3];
+    for (int d = 0; d < 3; ++d) {
+      const double u = std::floor(s.r[i][d] / box.L[d] * m);
+      c[d] = static_cast<std::uint32_t>(std::clamp(u, 0.0, double(m - 1)));
+    }
+    key[i] = hb::morton_code(c[0], c[1], c[2]);
+  }
+  return renumbered(s, hb::sorting_permutation(key));
+}
+
 inline Start lattice_start_of(const RigidPoint& pt) {
   Start st;
   with_rigid_assembly(config_of(pt), [&](const auto& as) {
@@ -348,19 +382,11 @@ inline Start lattice_start_of(const RigidPoint& pt) {
     st.state = std::move(s.state);
   });
   if (pt.shuffle) {  // the same bodies, numbered in a random order (fixed seed)
-    const hb::State& a = st.state;
-    std::vector<std::size_t> perm(a.size());
-    for (std::size_t k = 0; k < perm.size(); ++k) perm[k] = k;
+    std::vector<std::uint32_t> perm(st.state.size());
+    std::iota(perm.begin(), perm.end(), std::uint32_t(0));
     std::mt19937_64 g(pt.spec.seed);
     std::shuffle(perm.begin(), perm.end(), g);
-    hb::State b = a;
-    for (std::size_t k = 0; k < perm.size(); ++k) {
-      const std::size_t m = perm[k];
-      b.r[k] = a.r[m], b.v[k] = a.v[m], b.q[k] = a.q[m], b.w[k] = a.w[m], b.t[k] = a.t[m];
-      b.count[k] = a.count[m], b.image[k] = a.image[m], b.species[k] = a.species[m];
-      b.scale[k] = a.scale[m];
-    }
-    st.state = std::move(b);
+    st.state = renumbered(st.state, perm);
   }
   return st;
 }
@@ -406,6 +432,7 @@ inline Json describe(const RigidPoint& pt) {
   j["box_test"] = pt.box_test;
   j["memo"] = pt.memo;
   j["shuffle"] = pt.shuffle;
+  j["resort"] = pt.resort;
   j["method"] = pt.method;
   j["shell"] = pt.shell;
   j["eps_d"] = pt.spec.eps_d;
