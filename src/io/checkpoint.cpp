@@ -21,7 +21,20 @@ gsd::ChunkSource view(const std::vector<Vec3>& v) {
   return gsd::ChunkSource{gsd::Type::float64, v.size(), 3, v.empty() ? nullptr : v.data(), {}, {}};
 }
 gsd::ChunkSource view(const std::vector<double>& v) { return gsd::memory_source(v, 1); }
-gsd::ChunkSource quat_rows(const std::vector<Quat>& q) {
+// The same of State's hot fields (one record per body, so read row by row). The field, like the
+// State it belongs to, must outlive the frame's writing.
+template <Vec3 HotRecord::*M>
+gsd::ChunkSource view(const HotField<Vec3, M>& v) {
+  return gsd::row_source<double>(v.size(), 3, [&v](std::uint64_t i, double* o) {
+    o[0] = v[i].x(), o[1] = v[i].y(), o[2] = v[i].z();
+  });
+}
+template <double HotRecord::*M>
+gsd::ChunkSource view(const HotField<double, M>& v) {
+  return gsd::row_source<double>(v.size(), 1, [&v](std::uint64_t i, double* o) { *o = v[i]; });
+}
+template <Quat HotRecord::*M>
+gsd::ChunkSource quat_rows(const HotField<Quat, M>& q) {
   return gsd::row_source<double>(q.size(), 4, [&q](std::uint64_t i, double* o) {
     o[0] = q[i].w(), o[1] = q[i].x(), o[2] = q[i].y(), o[3] = q[i].z();
   });

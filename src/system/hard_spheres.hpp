@@ -28,19 +28,19 @@ struct HardSpheres {
   void contact_times(const State& s, const Box& box, std::uint32_t i, const std::uint32_t* js,
                      const Vec3* shifts, std::size_t n, double now, const double* /*horizons*/,
                      double* out) const {
-    const double* R = s.r.data()->data();
-    const double* V = s.v.data()->data();
-    const double* T = s.t.data();
-    const double xi = R[3 * i], yi = R[3 * i + 1], zi = R[3 * i + 2];
-    const double ui = V[3 * i], vi = V[3 * i + 1], wi = V[3 * i + 2];
+    const Vec3 ri = s.r[i], vi3 = s.v[i];
+    const double xi = ri.x(), yi = ri.y(), zi = ri.z();
+    const double ui = vi3.x(), vi = vi3.y(), wi = vi3.z();
     const double s2 = sigma * sigma;
     for (std::size_t k = 0; k < n; ++k) {
       const std::uint32_t j = js[k];
-      const double dt = now - T[j];
-      const double du = V[3 * j] - ui, dv = V[3 * j + 1] - vi, dw = V[3 * j + 2] - wi;
-      double dx = R[3 * j] + V[3 * j] * dt - xi;
-      double dy = R[3 * j + 1] + V[3 * j + 1] * dt - yi;
-      double dz = R[3 * j + 2] + V[3 * j + 2] * dt - zi;
+      const double dt = now - s.t[j];
+      const Vec3& Rj = s.r[j];
+      const Vec3& Vj = s.v[j];
+      const double du = Vj.x() - ui, dv = Vj.y() - vi, dw = Vj.z() - wi;
+      double dx = Rj.x() + Vj.x() * dt - xi;
+      double dy = Rj.y() + Vj.y() * dt - yi;
+      double dz = Rj.z() + Vj.z() * dt - zi;
       if (shifts) {
         dx += shifts[k].x(), dy += shifts[k].y(), dz += shifts[k].z();
       } else {

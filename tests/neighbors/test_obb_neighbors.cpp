@@ -90,7 +90,7 @@ void random_rebuilds_keep_lists_equal_to_brute_force(const Vec3& L) {
     s.q[i] = Quat(nrm(g), nrm(g), nrm(g), nrm(g)).normalized();
   };
   for (std::uint32_t i = 0; i < n; ++i) random_pose(i);
-  std::vector<Vec3> unwrapped = s.r;
+  std::vector<Vec3> unwrapped(s.r);
   ObbNeighbors<Ellipsoid> nb(e, 0.2);
   EXPECT_TRUE(nb.capsule_test());  // elongated boxes: on by default
   EXPECT_TRUE(nb.box_test());      // anisotropic boxes: on by default
@@ -249,7 +249,7 @@ void expect_overlap_free_and_conservative(Sim& sim, const RigidSystemSpec& spec)
   sim.synchronize();
   const double e1 = sim.model().kinetic_energy(sim.state());
   const OverlapReport ov =
-      ellipsoid_overlaps(sim.state().r, sim.state().q, sim.box(), spec.semi_axes);
+      ellipsoid_overlaps(std::vector<Vec3>(sim.state().r), std::vector<Quat>(sim.state().q), sim.box(), spec.semi_axes);
   std::printf("[ NNL ] %llu collisions: overlaps %lu, min gap %.3e, relative energy drift %.2e\n",
               (unsigned long long)sim.collisions(), (unsigned long)ov.overlaps, ov.min_distance,
               std::abs(e1 - e0) / e0);

@@ -157,7 +157,7 @@ TEST(Correlations, MultipleOriginsEqualBruteForce) {
     }
     const int samples = 90;
     std::vector<std::vector<Vec3>> R, U;  // unwrapped positions and axes per sample
-    std::vector<Vec3> unwrapped = s.r;
+    std::vector<Vec3> unwrapped(s.r);
     const Vec3 axis = spec.body_axis.normalized();
     for (int k = 0; k < samples; ++k) {
       if (k > 0) {
