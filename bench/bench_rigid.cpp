@@ -48,8 +48,8 @@ namespace {
 // Overlaps of a synchronized state by the independent test of the shape (Perram–Wertheim for
 // ellipsoids, surface sampling for superquadrics).
 hb::OverlapReport overlaps_of(const hb::State& s, const hb::Box& box, const RigidPoint& pt) {
-  if (pt.shape == "ellipsoid") return hb::ellipsoid_overlaps(std::vector<hb::Vec3>(s.r), std::vector<hb::Quat>(s.q), box, pt.spec.semi_axes);
-  return hb::superquadric_overlaps(std::vector<hb::Vec3>(s.r), std::vector<hb::Quat>(s.q), box, hb::superquadric_shape(pt.spec));
+  if (pt.shape == "ellipsoid") return hb::ellipsoid_overlaps(s.r, s.q, box, pt.spec.semi_axes);
+  return hb::superquadric_overlaps(s.r, s.q, box, hb::superquadric_shape(pt.spec));
 }
 
 // A `hardbody distance` input line for the pair that a failure message names ("... i and j"),
@@ -168,7 +168,7 @@ int run(int argc, char** argv) {
                            {"stale", sp.stale / w}};
       }
       st = Start{sim.box(), hb::synchronized_state(sim), sim.now()};
-      j["S2"] = hb::nematic_order(std::vector<hb::Quat>(st.state.q), Vec3::UnitX()).S2;
+      j["S2"] = hb::nematic_order(st.state.q, Vec3::UnitX()).S2;
       if (!failure.empty()) j["reproducer"] = pair_reproducer(failure, st, sim.model().shape);
       if (check) {
         const hb::OverlapReport rep = overlaps_of(st.state, st.box, q);

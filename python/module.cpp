@@ -89,7 +89,7 @@ py::array_t<double> table(std::size_t rows, std::size_t cols, F&& fill) {
   for (std::size_t i = 0; i < rows; ++i) fill(i, &m(i, 0));
   return a;
 }
-py::array_t<double> vec3_table(const std::vector<Vec3>& v) {
+py::array_t<double> vec3_table(FieldView<Vec3> v) {
   return table(v.size(), 3, [&](std::size_t i, double* o) {
     for (int k = 0; k < 3; ++k) o[k] = v[i][k];
   });
@@ -182,7 +182,7 @@ class Simulation {
     return d;
   }
 
-  py::array_t<double> positions() const { return vec3_table(std::vector<Vec3>(sim_->synchronized().r)); }
+  py::array_t<double> positions() const { return vec3_table(sim_->synchronized().r); }
   py::array_t<double> unwrapped_positions() const {
     const State s = sim_->synchronized();
     const Vec3 L = sim_->box().L;
@@ -190,8 +190,8 @@ class Simulation {
       for (int k = 0; k < 3; ++k) o[k] = s.r[i][k] + double(s.image[i][k]) * L[k];
     });
   }
-  py::array_t<double> velocities() const { return vec3_table(std::vector<Vec3>(sim_->synchronized().v)); }
-  py::array_t<double> angular_velocities() const { return vec3_table(std::vector<Vec3>(sim_->synchronized().w)); }
+  py::array_t<double> velocities() const { return vec3_table(sim_->synchronized().v); }
+  py::array_t<double> angular_velocities() const { return vec3_table(sim_->synchronized().w); }
   py::array_t<double> orientations() const {
     const State s = sim_->synchronized();
     return table(s.size(), 4, [&](std::size_t i, double* o) {

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/field_view.hpp"
 #include "math/types.hpp"
 #include "motion/free_flight.hpp"
 
@@ -26,7 +27,8 @@ struct alignas(64) HotRecord {
 // One field of every body's record, indexed like the std::vector it replaces (s.r[i]). A view
 // cannot be copied, since the copy would alias the body's records. It converts to a
 // std::vector<T> (a copy of the values) only explicitly: an implicit copy could be bound to a
-// reference that outlives it. Assigning a vector to a view writes its values into the records; a
+// reference that outlives it. Functions that only read a field take a FieldView, to which a view
+// converts implicitly (no copy: it reads the records in place). Assigning a vector to a view writes its values into the records; a
 // vector of another length first resizes the records of every field (assign the fields of a new
 // State at one length).
 template <class T, T HotRecord::*M>
@@ -53,6 +55,9 @@ class HotField {
     out.reserve(h_->size());
     for (const auto& e : *h_) out.push_back(e.*M);
     return out;
+  }
+  operator FieldView<T>() const {  // NOLINT: implicit by design (read-only, no copy)
+    return h_->empty() ? FieldView<T>() : FieldView<T>(&((*h_)[0].*M), sizeof(HotRecord), h_->size());
   }
   template <class H, class V>
   struct Iter {

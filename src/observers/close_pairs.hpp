@@ -8,11 +8,12 @@
 
 #include "math/types.hpp"
 #include "core/box.hpp"
+#include "core/field_view.hpp"
 
 namespace hb {
 
 // fn(i, j, d) with d the minimum image of r[j] - r[i].
-void for_close_pairs(const std::vector<Vec3>& r, const Box& box, double range,
+void for_close_pairs(FieldView<Vec3> r, const Box& box, double range,
                      const std::function<void(std::uint32_t, std::uint32_t, const Vec3&)>& fn);
 
 }  // namespace hb

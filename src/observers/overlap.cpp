@@ -20,7 +20,7 @@ inline void check_pair(const Vec3& a, const Vec3& b, const Box& box, double sigm
 }
 }  // namespace
 
-OverlapReport sphere_overlaps_brute(const std::vector<Vec3>& r, const Box& box, double sigma,
+OverlapReport sphere_overlaps_brute(FieldView<Vec3> r, const Box& box, double sigma,
                                     double tol) {
   OverlapReport rep;
   for (std::size_t i = 0; i < r.size(); ++i)
@@ -28,7 +28,7 @@ OverlapReport sphere_overlaps_brute(const std::vector<Vec3>& r, const Box& box, 
   return rep;
 }
 
-void for_close_pairs(const std::vector<Vec3>& r, const Box& box, double range,
+void for_close_pairs(FieldView<Vec3> r, const Box& box, double range,
                      const std::function<void(std::uint32_t, std::uint32_t, const Vec3&)>& fn) {
   int nc[3];
   bool brute = box.L.minCoeff() < 3.0 * range;
@@ -73,7 +73,7 @@ void for_close_pairs(const std::vector<Vec3>& r, const Box& box, double range,
         }
 }
 
-OverlapReport ellipsoid_overlaps(const std::vector<Vec3>& r, const std::vector<Quat>& q,
+OverlapReport ellipsoid_overlaps(FieldView<Vec3> r, FieldView<Quat> q,
                                  const Box& box, const Vec3& semi_axes, double tol) {
   OverlapReport rep;
   for_close_pairs(r, box, 2.0 * semi_axes.maxCoeff(), [&](std::uint32_t i, std::uint32_t j, const Vec3& d) {
@@ -87,7 +87,7 @@ OverlapReport ellipsoid_overlaps(const std::vector<Vec3>& r, const std::vector<Q
   return rep;
 }
 
-OverlapReport sphere_overlaps_grid(const std::vector<Vec3>& r, const Box& box, double sigma,
+OverlapReport sphere_overlaps_grid(FieldView<Vec3> r, const Box& box, double sigma,
                                    double tol) {
   // Pairs closer than 2 sigma: every overlap, and the closest pair of any configuration
   // that is not extremely dilute (min_distance then agrees with the brute force).
@@ -98,7 +98,7 @@ OverlapReport sphere_overlaps_grid(const std::vector<Vec3>& r, const Box& box, d
   return rep;
 }
 
-OverlapReport sphere_overlaps(const std::vector<Vec3>& r, const Box& box, double sigma,
+OverlapReport sphere_overlaps(FieldView<Vec3> r, const Box& box, double sigma,
                               double tol) {
   return r.size() <= 20000 ? sphere_overlaps_brute(r, box, sigma, tol)
                            : sphere_overlaps_grid(r, box, sigma, tol);
@@ -108,7 +108,7 @@ OverlapReport sphere_overlaps(const std::vector<Vec3>& r, const Box& box, double
 
 namespace hb {
 
-OverlapReport sphere_mixture_overlaps(const std::vector<Vec3>& r, const std::vector<double>& radii,
+OverlapReport sphere_mixture_overlaps(FieldView<Vec3> r, const std::vector<double>& radii,
                                       const Box& box, double tol) {
   OverlapReport rep;
   double rmax = 0.0;

@@ -9,6 +9,7 @@
 #include "math/types.hpp"
 #include <functional>
 #include "core/box.hpp"
+#include "core/field_view.hpp"
 
 namespace hb {
 
@@ -18,17 +19,17 @@ struct OverlapReport {
   std::uint64_t pairs_checked = 0;
 };
 
-OverlapReport sphere_overlaps_brute(const std::vector<Vec3>& r, const Box& box, double sigma,
+OverlapReport sphere_overlaps_brute(FieldView<Vec3> r, const Box& box, double sigma,
                                     double tol = 1e-10);
-OverlapReport sphere_overlaps_grid(const std::vector<Vec3>& r, const Box& box, double sigma,
+OverlapReport sphere_overlaps_grid(FieldView<Vec3> r, const Box& box, double sigma,
                                    double tol = 1e-10);
 // Brute force up to 20000 bodies, grid beyond.
-OverlapReport sphere_overlaps(const std::vector<Vec3>& r, const Box& box, double sigma,
+OverlapReport sphere_overlaps(FieldView<Vec3> r, const Box& box, double sigma,
                               double tol = 1e-10);
 
 // Spheres of unequal radii (mixtures, polydispersity): overlap when |r_ij| < (R_i + R_j)(1 - tol);
 // min_distance is the smallest surface gap |r_ij| - R_i - R_j. Candidates from a fresh grid.
-OverlapReport sphere_mixture_overlaps(const std::vector<Vec3>& r, const std::vector<double>& radii,
+OverlapReport sphere_mixture_overlaps(FieldView<Vec3> r, const std::vector<double>& radii,
                                       const Box& box, double tol = 1e-10);
 
 // Ellipsoids (all with the same semi-axes, orientations body -> lab): the Perram–Wertheim
@@ -36,7 +37,7 @@ OverlapReport sphere_mixture_overlaps(const std::vector<Vec3>& r, const std::vec
 // pair whose centres are closer than the bounding diameter; overlap when F < 1 - tol.
 // min_distance is the smallest centre-line gap |r_AB| (1 - 1/sqrt(F)): zero at contact,
 // negative for overlap. Candidate pairs come from a fresh grid (brute force for small boxes).
-OverlapReport ellipsoid_overlaps(const std::vector<Vec3>& r, const std::vector<Quat>& q,
+OverlapReport ellipsoid_overlaps(FieldView<Vec3> r, FieldView<Quat> q,
                                  const Box& box, const Vec3& semi_axes, double tol = 1e-10);
 
 }  // namespace hb

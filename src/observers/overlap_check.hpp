@@ -25,18 +25,18 @@ using OverlapCheck = std::function<OverlapReport(const State&, const Box&)>;
 
 namespace overlap_check_detail {
 inline OverlapCheck of(const Sphere& s) {
-  return [sigma = 2.0 * s.radius](const State& st, const Box& b) { return sphere_overlaps(std::vector<Vec3>(st.r), b, sigma); };
+  return [sigma = 2.0 * s.radius](const State& st, const Box& b) { return sphere_overlaps(st.r, b, sigma); };
 }
 inline OverlapCheck of(const Ellipsoid& e) {
   return [axes = e.half_extents()](const State& st, const Box& b) {
-    return ellipsoid_overlaps(std::vector<Vec3>(st.r), std::vector<Quat>(st.q), b, axes);
+    return ellipsoid_overlaps(st.r, st.q, b, axes);
   };
 }
 // Any other shape: one surface sampling shared by every check of the run.
 template <Shape S>
 OverlapCheck of(const S& shape) {
   auto check = std::make_shared<const SurfaceSampling<S>>(shape);
-  return [check](const State& st, const Box& b) { return sampled_overlaps(std::vector<Vec3>(st.r), std::vector<Quat>(st.q), b, *check); };
+  return [check](const State& st, const Box& b) { return sampled_overlaps(st.r, st.q, b, *check); };
 }
 }  // namespace overlap_check_detail
 
@@ -136,7 +136,7 @@ struct MixturePlan {
     }
     OverlapReport rep;
     if (n < 2) return rep;
-    for_close_pairs(std::vector<Vec3>(st.r), box, (all_spheres ? 4.0 : 2.0) * rmax, [&](std::uint32_t i, std::uint32_t j, const Vec3& d) {
+    for_close_pairs(st.r, box, (all_spheres ? 4.0 : 2.0) * rmax, [&](std::uint32_t i, std::uint32_t j, const Vec3& d) {
       const std::size_t a = species(i), b = species(j);
       const double sa = scale(i), sb = scale(j);
       double gap;

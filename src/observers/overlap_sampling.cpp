@@ -18,7 +18,7 @@ std::vector<Vec3> fibonacci_sphere(int n) {
 
 }  // namespace sampling_detail
 
-OverlapReport superquadric_overlaps(const std::vector<Vec3>& r, const std::vector<Quat>& q,
+OverlapReport superquadric_overlaps(FieldView<Vec3> r, FieldView<Quat> q,
                                     const Box& box, const Superquadric& shape, double tol) {
   const SurfaceSampling<Superquadric> check(shape, SurfaceSampling<Superquadric>::kDefaultSamples, tol);
   return sampled_overlaps(r, q, box, check);

@@ -286,7 +286,7 @@ SampledPair sampled_pair(const SurfaceSampling<SA>& a, double sa, const Quat& qa
 // Every pair of identical bodies (positions r, orientations q) closer than the bounding
 // diameter, checked by `check`.  min_distance is the smallest gap estimate.
 template <Shape S>
-OverlapReport sampled_overlaps(const std::vector<Vec3>& r, const std::vector<Quat>& q,
+OverlapReport sampled_overlaps(FieldView<Vec3> r, FieldView<Quat> q,
                                const Box& box, const SurfaceSampling<S>& check) {
   OverlapReport rep;
   const double range = 2.0 * check.shape().bounding_radius();
@@ -300,7 +300,7 @@ OverlapReport sampled_overlaps(const std::vector<Vec3>& r, const std::vector<Qua
 }
 
 // Superquadrics (all with the same shape): sampled_overlaps with the default sampling.
-OverlapReport superquadric_overlaps(const std::vector<Vec3>& r, const std::vector<Quat>& q,
+OverlapReport superquadric_overlaps(FieldView<Vec3> r, FieldView<Quat> q,
                                     const Box& box, const Superquadric& shape, double tol = 1e-10);
 
 }  // namespace hb

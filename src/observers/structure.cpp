@@ -69,7 +69,7 @@ Grid plan_grid(const Box& box, std::size_t n, double r_max, double cell_side) {
 // The common pair search of pair_histogram and PartialRadialDistribution: calls
 // visit(i, j, bin) for every counted pair within r_max (i the centre in subset mode).
 template <class Visit>
-PairCount for_each_pair(const std::vector<Vec3>& p, const Box& box, double r_max, std::size_t bins,
+PairCount for_each_pair(FieldView<Vec3> p, const Box& box, double r_max, std::size_t bins,
                         const PairSearch& search, Visit&& visit) {
   check_range(box, r_max);
   if (bins == 0) throw std::invalid_argument("g(r): no bins");
@@ -200,7 +200,7 @@ void wrapped_positions(const State& state, const Box& box, double time, std::vec
 
 }  // namespace
 
-PairCount pair_histogram(const std::vector<Vec3>& p, const Box& box, double r_max,
+PairCount pair_histogram(FieldView<Vec3> p, const Box& box, double r_max,
                          std::vector<std::uint64_t>& hist, const PairSearch& search) {
   std::vector<std::uint64_t> h(hist.size(), 0);
   const PairCount pc = for_each_pair(p, box, r_max, h.size(), search,
@@ -465,7 +465,7 @@ std::string PartialRadialDistribution::to_tsv(const std::vector<std::string>& na
   return out;
 }
 
-NematicResult nematic_order(const std::vector<Quat>& orientations, const Vec3& body_axis) {
+NematicResult nematic_order(FieldView<Quat> orientations, const Vec3& body_axis) {
   NematicResult res;
   if (orientations.empty()) return res;
   const Vec3 a = body_axis.normalized();

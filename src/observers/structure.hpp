@@ -60,7 +60,7 @@ struct PairCount {
 // ordered pairs (i, j), i a centre, j != i. `positions` must lie in [0, L) and
 // r_max <= min(L)/2; throws std::invalid_argument otherwise. Polls for interrupts; `hist` is
 // unchanged when it throws. The tests compare it with an all-pairs loop.
-PairCount pair_histogram(const std::vector<Vec3>& positions, const Box& box, double r_max,
+PairCount pair_histogram(FieldView<Vec3> positions, const Box& box, double r_max,
                          std::vector<std::uint64_t>& hist, const PairSearch& search = {});
 
 class RadialDistribution {
@@ -177,7 +177,7 @@ struct NematicResult {
   Vec3 director = Vec3::UnitX();
   Vec3 eigenvalues = Vec3::Zero();  // ascending
 };
-NematicResult nematic_order(const std::vector<Quat>& orientations,
+NematicResult nematic_order(FieldView<Quat> orientations,
                             const Vec3& body_axis = Vec3::UnitX());
 
 class NematicOrder {

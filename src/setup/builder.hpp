@@ -211,7 +211,7 @@ void assemble_spheres(const Config& c, F&& f) {
                   [model](const State& s, const Box& b) {
                     std::vector<double> radii(s.size());
                     for (std::size_t i = 0; i < s.size(); ++i) radii[i] = model.body_radius(s, i);
-                    return sphere_mixture_overlaps(std::vector<Vec3>(s.r), radii, b);
+                    return sphere_mixture_overlaps(s.r, radii, b);
                   }};
     GrowthOptions go;
     go.rate = c.init_growth_rate;

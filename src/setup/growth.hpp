@@ -350,7 +350,7 @@ GrowthResult grow_lattice(const S& shape, const RigidSystemSpec& spec, const Gro
 inline GrowthResult grow_to(const RigidSystemSpec& spec, const GrowthOptions& opt = {}) {
   const Ellipsoid shape{spec.semi_axes.x(), spec.semi_axes.y(), spec.semi_axes.z()};
   return grow_lattice(shape, spec, opt, ellipsoid_start, [&](const State& s, const Box& b) {
-    return ellipsoid_overlaps(std::vector<Vec3>(s.r), std::vector<Quat>(s.q), b, spec.semi_axes);
+    return ellipsoid_overlaps(s.r, s.q, b, spec.semi_axes);
   });
 }
 

@@ -249,7 +249,7 @@ void expect_overlap_free_and_conservative(Sim& sim, const RigidSystemSpec& spec)
   sim.synchronize();
   const double e1 = sim.model().kinetic_energy(sim.state());
   const OverlapReport ov =
-      ellipsoid_overlaps(std::vector<Vec3>(sim.state().r), std::vector<Quat>(sim.state().q), sim.box(), spec.semi_axes);
+      ellipsoid_overlaps(sim.state().r, sim.state().q, sim.box(), spec.semi_axes);
   std::printf("[ NNL ] %llu collisions: overlaps %lu, min gap %.3e, relative energy drift %.2e\n",
               (unsigned long long)sim.collisions(), (unsigned long)ov.overlaps, ov.min_distance,
               std::abs(e1 - e0) / e0);

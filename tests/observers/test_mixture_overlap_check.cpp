@@ -196,9 +196,9 @@ TEST(MixtureOverlapCheck, IdenticalSpheresAgreeWithIdenticalChecks) {
   for (int rep = 0; rep < 4; ++rep) {
     const Box box = cube(8.0);
     const State st = dense_state(500, 8.0, 2, 100 + rep, 4 * rep, 0.6);  // fcc spacing 1.13
-    const OverlapReport brute = sphere_overlaps(std::vector<Vec3>(st.r), box, 2.0 * s.radius);  // all pairs
-    const OverlapReport grid = sphere_overlaps_grid(std::vector<Vec3>(st.r), box, 2.0 * s.radius);
-    const OverlapReport mix = sphere_mixture_overlaps(std::vector<Vec3>(st.r), std::vector<double>(st.size(), s.radius), box);
+    const OverlapReport brute = sphere_overlaps(st.r, box, 2.0 * s.radius);  // all pairs
+    const OverlapReport grid = sphere_overlaps_grid(st.r, box, 2.0 * s.radius);
+    const OverlapReport mix = sphere_mixture_overlaps(st.r, std::vector<double>(st.size(), s.radius), box);
     // one species, and the same shape listed as two species
     State st1 = st;
     st1.species.assign(st.size(), 0);
@@ -232,7 +232,7 @@ TEST(MixtureOverlapCheck, IdenticalEllipsoidsAgreeWithPerramWertheimCheck) {
   const Box box = cube(9.0);
   for (int rep = 0; rep < 3; ++rep) {
     const State st = dense_state(864, 9.0, 3, 200 + rep, 5 * rep, 0.5);
-    const OverlapReport ref = ellipsoid_overlaps(std::vector<Vec3>(st.r), std::vector<Quat>(st.q), box, e.half_extents());
+    const OverlapReport ref = ellipsoid_overlaps(st.r, st.q, box, e.half_extents());
     const OverlapReport got = mixture_overlap_check({AnyShape(e), AnyShape(e), AnyShape(e)})(st, box);
     EXPECT_EQ(got.overlaps, ref.overlaps) << "rep " << rep;
     EXPECT_EQ(got.pairs_checked, ref.pairs_checked) << "rep " << rep;
@@ -251,7 +251,7 @@ TEST(MixtureOverlapCheck, IdenticalSuperquadricsAgreeWithSamplingCheck) {
   const int reps = hb::testing::scaled_count(2, 0.5, 1);  // 1 under Debug/sanitizers
   for (int rep = 0; rep < reps; ++rep) {
     const State st = dense_state(n, 5.4, 2, 300 + rep, 3 * rep, 0.5);
-    const OverlapReport ref = superquadric_overlaps(std::vector<Vec3>(st.r), std::vector<Quat>(st.q), box, q);
+    const OverlapReport ref = superquadric_overlaps(st.r, st.q, box, q);
     const OverlapReport got = mixture_overlap_check({AnyShape(q), AnyShape(q)})(st, box);
     EXPECT_EQ(got.overlaps, ref.overlaps) << "rep " << rep;
     EXPECT_EQ(got.pairs_checked, ref.pairs_checked) << "rep " << rep;

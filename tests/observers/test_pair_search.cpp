@@ -255,7 +255,7 @@ TEST(PairSearch, InterruptLeavesTheObserversUnchanged) {
     }
     EXPECT_THROW(part.sample(1.0, s, box, rdf.r_max()), Interrupted);
     std::vector<std::uint64_t> h(10, 0);
-    EXPECT_THROW(pair_histogram(std::vector<Vec3>(s.r), box, 4.0, h), Interrupted);
+    EXPECT_THROW(pair_histogram(s.r, box, 4.0, h), Interrupted);
     EXPECT_EQ(h, std::vector<std::uint64_t>(10, 0));
   }
   EXPECT_EQ(rdf.save(), before);

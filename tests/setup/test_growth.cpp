@@ -107,7 +107,7 @@ TEST(Growth, GrowingRunStaysOverlapFree) {
     }
     sim.synchronize();
     const double s = law.scale_at(t);
-    const OverlapReport ov = ellipsoid_overlaps(std::vector<Vec3>(sim.state().r), std::vector<Quat>(sim.state().q), box, spec.semi_axes * s);
+    const OverlapReport ov = ellipsoid_overlaps(sim.state().r, sim.state().q, box, spec.semi_axes * s);
     EXPECT_EQ(ov.overlaps, 0u) << "t " << t;
     const double k = sim.model().kinetic_energy(sim.state());
     EXPECT_GE(k, k_prev * (1 - 1e-12)) << "t " << t;  // growth collisions only heat
@@ -148,7 +148,7 @@ void grow_case(const Vec3& axes, const char* name) {
   EXPECT_NEAR(double(spec.n) * v / res.box.volume(), spec.phi, 1e-12);
   EXPECT_EQ(res.overlaps.overlaps, 0u);
   // an independent check here as well
-  const OverlapReport ov = ellipsoid_overlaps(std::vector<Vec3>(res.state.r), std::vector<Quat>(res.state.q), res.box, axes);
+  const OverlapReport ov = ellipsoid_overlaps(res.state.r, res.state.q, res.box, axes);
   EXPECT_EQ(ov.overlaps, 0u);
   // synchronized at time 0 of the continuing run, at temperature kT
   for (std::size_t i = 0; i < res.state.size(); ++i) ASSERT_EQ(res.state.t[i], 0.0);
@@ -164,7 +164,7 @@ void grow_case(const Vec3& axes, const char* name) {
   while (sim.collisions() < 20 * spec.n && sim.step(kInf).type != EventType::None) {
   }
   sim.synchronize();
-  EXPECT_EQ(ellipsoid_overlaps(std::vector<Vec3>(sim.state().r), std::vector<Quat>(sim.state().q), sim.box(), axes).overlaps, 0u);
+  EXPECT_EQ(ellipsoid_overlaps(sim.state().r, sim.state().q, sim.box(), axes).overlaps, 0u);
   EXPECT_NEAR(sim.model().kinetic_energy(sim.state()), e0, 1e-8 * e0);
 }
 

@@ -40,7 +40,7 @@ std::vector<Vec3> row_order_sites(const RigidSystemSpec& s) {
   return r;
 }
 
-std::vector<std::array<double, 3>> sorted(const std::vector<Vec3>& r) {
+std::vector<std::array<double, 3>> sorted(FieldView<Vec3> r) {
   std::vector<std::array<double, 3>> a;
   for (const Vec3& p : r) a.push_back({p.x(), p.y(), p.z()});
   std::sort(a.begin(), a.end());
@@ -49,7 +49,7 @@ std::vector<std::array<double, 3>> sorted(const std::vector<Vec3>& r) {
 
 // The fraction of the pairs of nearest lattice neighbours (minimum image) numbered at most
 // `window` apart, the distance measured on the unit lattice (positions divided by the semi-axes).
-double near_in_numbering(const std::vector<Vec3>& r, const Box& box, const Vec3& axes,
+double near_in_numbering(FieldView<Vec3> r, const Box& box, const Vec3& axes,
                          std::size_t window) {
   const Vec3 L = box.L.cwiseQuotient(axes);
   auto dist = [&](std::size_t i, std::size_t j) {
@@ -74,7 +74,7 @@ TEST(LatticeStart, SitesAreTheRowOrderSitesRenumbered) {
     Box box;
     const State st = ellipsoid_start(s, box);
     ASSERT_EQ(st.size(), n);
-    EXPECT_EQ(sorted(std::vector<Vec3>(st.r)), sorted(row_order_sites(s))) << "n = " << n;
+    EXPECT_EQ(sorted(st.r), sorted(row_order_sites(s))) << "n = " << n;
   }
 }
 
@@ -86,7 +86,7 @@ TEST(LatticeStart, NeighboursGetNearbyNumbers) {
   const RigidSystemSpec s = spec_of(6912);
   Box box;
   const State st = ellipsoid_start(s, box);
-  const double curve = near_in_numbering(std::vector<Vec3>(st.r), box, s.semi_axes, 256);
+  const double curve = near_in_numbering(st.r, box, s.semi_axes, 256);
   const double rows = near_in_numbering(row_order_sites(s), box, s.semi_axes, 256);
   EXPECT_LE(rows, 0.7);  // the premise
   EXPECT_GE(curve, 0.78) << "row order: " << rows;

@@ -1,7 +1,7 @@
 // State keeps each body's hot fields (r, v, q, w, t) in one record and shows them through
 // per-field views. These tests pin what the views promise: each reads and writes its own field
 // of its own body, and a copied or moved State owns its records (a view never aliases another
-// State's storage).
+// State's storage); a read-only FieldView sees a field in place.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -126,6 +126,36 @@ TEST(State, AFieldCopiesOutToAVectorAndBackIn) {
   double sum = 0.0;
   for (double x : s.t) sum += x;
   EXPECT_EQ(sum, 1014.0 + 1114.0 + 1214.0);
+}
+
+// The read-only view that observers take sees a State's field in place, with the same values,
+// length and order as a copy of it or as a plain vector.
+TEST(State, AReadOnlyViewSeesTheFieldInPlace) {
+  State s;
+  s.resize(4);
+  fill(s);
+  const FieldView<Vec3> r = s.r;
+  const FieldView<Quat> q = s.q;
+  const FieldView<double> t = s.t;
+  const std::vector<Vec3> copy(s.r);
+  const FieldView<Vec3> c = copy;
+  ASSERT_EQ(r.size(), 4u);
+  ASSERT_EQ(c.size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(&r[i], &s.r[i]) << i;  // no copy: the record's own field
+    EXPECT_EQ(r[i], c[i]) << i;
+    EXPECT_EQ(q[i].coeffs(), s.q[i].coeffs()) << i;
+    EXPECT_EQ(t[i], s.t[i]) << i;
+  }
+  std::size_t k = 0;
+  for (const Vec3& x : r) EXPECT_EQ(x, copy[k++]);
+  EXPECT_EQ(k, 4u);
+  s.r[2] = Vec3(-1, -2, -3);  // a view follows later writes
+  EXPECT_EQ(r[2], Vec3(-1, -2, -3));
+  State e;
+  const FieldView<Vec3> none = e.r;
+  EXPECT_TRUE(none.empty());
+  EXPECT_EQ(none.begin(), none.end());
 }
 
 }  // namespace
