@@ -28,9 +28,9 @@ struct alignas(64) HotRecord {
 // cannot be copied, since the copy would alias the body's records. It converts to a
 // std::vector<T> (a copy of the values) only explicitly: an implicit copy could be bound to a
 // reference that outlives it. Functions that only read a field take a FieldView, to which a view
-// converts implicitly (no copy: it reads the records in place). Assigning a vector to a view writes its values into the records; a
-// vector of another length first resizes the records of every field (assign the fields of a new
-// State at one length).
+// converts implicitly (no copy: it reads the records in place). Assigning a vector to a view
+// writes its values into the records; a vector of another length first resizes the records of
+// every field (assign the fields of a new State at one length).
 template <class T, T HotRecord::*M>
 class HotField {
  public:
