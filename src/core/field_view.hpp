@@ -7,7 +7,6 @@
 // (as a function parameter, it may look at a temporary that lives to the end of the call).
 #pragma once
 #include <cstddef>
-#include <iterator>
 #include <vector>
 
 namespace hb {
@@ -24,19 +23,18 @@ class FieldView {
   std::size_t size() const { return n_; }
   bool empty() const { return n_ == 0; }
 
+  // For range-for: it holds the base pointer and stride itself, so it stays valid when the view
+  // it came from (often a temporary) is gone.
   struct Iter {
-    const FieldView* v;
-    std::size_t i;
-    using difference_type = std::ptrdiff_t;
-    using value_type = T;
-    using iterator_category = std::forward_iterator_tag;
-    const T& operator*() const { return (*v)[i]; }
-    Iter& operator++() { ++i; return *this; }
-    bool operator==(const Iter& o) const { return i == o.i; }
-    bool operator!=(const Iter& o) const { return i != o.i; }
+    const char* p;
+    std::size_t stride;
+    const T& operator*() const { return *reinterpret_cast<const T*>(p); }
+    Iter& operator++() { p += stride; return *this; }
+    bool operator==(const Iter& o) const { return p == o.p; }
+    bool operator!=(const Iter& o) const { return p != o.p; }
   };
-  Iter begin() const { return {this, 0}; }
-  Iter end() const { return {this, n_}; }
+  Iter begin() const { return {p_, stride_}; }
+  Iter end() const { return {p_ + n_ * stride_, stride_}; }
 
  private:
   const char* p_ = nullptr;
