@@ -6,7 +6,9 @@
 //   (a number: a spherical top; solid: the uniform solid's principal moments)
 //   method=nnl|cells  shell=0.15  eps_d=1e-5  seed=1  revolution=1 (0: the spheroids' rate
 //   bounds from |w|, not from the spin across their axes: the slow twin)  box_test=1 (0: the
-//   neighbour lists' axis-aligned box pre-test off, where it would be on: the slow twin)  memo=1
+//   neighbour lists' axis-aligned box pre-test off, where it would be on: the slow twin)
+//   short_windows=1 (0: the neighbour lists' escape searches over 8 circumradii' flight, with a
+//   rebuild at the window's end, not over a quarter and keeping the box: the slow twin)  memo=1
 //   (0: no pair's last separating axis kept after the start, every search cold: the slow twin)
 //   shuffle=0 (1: the lattice start's bodies numbered at random, not along its Morton curve)
 //   resort=0 (1: where a scan rebuilds the simulation from the state the point before ended

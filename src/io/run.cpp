@@ -639,6 +639,8 @@ class Driver {
     j["snapshot_min_distance"] = snapshot_min_gap_;
     if constexpr (requires { sim_.neighbors().truncated_searches(); })
       j["nnl_escape_searches_truncated"] = sim_.neighbors().truncated_searches();
+    if constexpr (requires { sim_.neighbors().window_ends(); })  // in events.nnl_rebuild, box kept
+      j["nnl_window_ends"] = sim_.neighbors().window_ends();
     if (cfg_.obs_interval > 0.0) {
       const auto fit = corr_.diffusion();
       if (fit.points > 0) {

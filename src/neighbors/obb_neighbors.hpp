@@ -185,6 +185,7 @@ class ObbNeighbors {
   double margin() const { return margin_; }
   double circumradius() const { return rc_; }
   std::uint64_t rebuilds() const { return rebuilds_; }
+  std::uint64_t window_ends() const { return window_ends_; }  // window ends without a rebuild
   std::uint64_t truncated_searches() const { return truncated_; }
   bool needs_minimum_image() const { return true; }
   // Body i's box at the periodic image nearest to the point r (a led box's centre is wrapped
@@ -195,6 +196,22 @@ class ObbNeighbors {
     b.centre += pbox_.near_image(d) - d;  // whole periods: the same bits when none
     return b;
   }
+  // The escape search's window (next_event): [now, now + f rc / K], rc the box's circumradius
+  // and K the body's speed bound. The window's end is also the body's horizon: its pair
+  // predictions look no further (Simulation::predict), so a shorter window makes cheaper pair
+  // searches (fewer axis steps) and escape searches, at the cost of more events. Where the
+  // body is still inside its box at the window's end, the box stays and the body is predicted
+  // anew from there (no rebuild, no cell walk, no list update).
+  // On (the default): f = 1/4, no rebuild at the window's end. Off: f = 8 and a rebuild there,
+  // the earlier rule (the slow twin of the tests).
+  // Measured (callgrind, instructions a collision, docs/benchmarks/README.md, "Session of
+  // 2026-12-05, sixth part"), off -> on: ellipsoids X0 = 2 at phi = 0.5, N = 256 (e1) 106.1k
+  // -> 97.4k; at phi = 0.3 142.7k -> 140.1k; X0 = 1 and 10 at phi = 0.4 -2.2 % and -0.4 %;
+  // superquadrics (2, 2, 8) at phi = 0.256 -2.6 %, (2, 2, 2) +1.2 %. f = 1/8 gains more at
+  // phi = 0.5 (92.3k) but loses 10 % at phi = 0.3 and X0 = 1 (the window ends too often).
+  void set_short_windows(bool on) { short_windows_ = on; }
+  bool short_windows() const { return short_windows_; }
+  double window() const { return short_windows_ ? 0.25 : 8.0; }
   // Boxes led along the flight (on by default); off: every box centred on its body at its
   // rebuild, the paper's (the slow twin of the tests).
   void set_lead(bool on) { lead_ = on; }
@@ -227,7 +244,7 @@ class ObbNeighbors {
       const double sc = s.scale[i];
       const double K = b.v.norm() + b.w.norm() * kind.bound * sc;
       if (K == 0.0) return e;  // at rest: never leaves
-      const double t_cap = now + 8.0 * obb_[i].half.norm() / K;
+      const double t_cap = now + window() * obb_[i].half.norm() / K;
       const double margin = body_margin(kind.inscribed * sc);
       const AnyShape shape = sc == 1.0 ? kind.shape : resized(kind.shape, sc);
       return escape_event(e, now, t_cap, std::visit([&](const auto& x) {
@@ -238,7 +255,7 @@ class ObbNeighbors {
     } else {
       const double K = b.v.norm() + b.w.norm() * kbound_l_;
       if (K == 0.0) return e;  // at rest: never leaves
-      const double t_cap = now + 8.0 * rc_ / K;
+      const double t_cap = now + window() * rc_ / K;
       EscapeInput<S> in{shape_, b, s.t[i], now, t_cap, box_near(i, b.r), margin_, eps_};
       in.revolution = revolution_;
       return escape_event(e, now, t_cap, escape_time(in, escape_options(margin_)));
@@ -261,7 +278,7 @@ class ObbNeighbors {
         break;
       case EscapeStatus::inside:
         e.time = r.truncated ? r.time : t_cap;
-        e.partner = 6;
+        e.partner = kWindowEnd;
         break;
     }
     return e;
@@ -272,7 +289,11 @@ class ObbNeighbors {
   // Rebuild body i's box around its current pose (body already streamed to the event time) and
   // update the lists it appears in. Returns false: predict i against its whole new list.
   template <class Fn>
-  bool handle(std::uint32_t i, const Event&, State& s, const Box& box, Fn&&) {
+  bool handle(std::uint32_t i, const Event& ev, State& s, const Box& box, Fn&&) {
+    if (ev.partner == kWindowEnd && short_windows_) {  // still inside: keep the box, predict anew
+      ++window_ends_;
+      return false;
+    }
     ++rebuilds_;
     s.image[i] += box.wrap(s.r[i]);
     members_.remove(cells_.cell_of(i), i);
@@ -522,6 +543,9 @@ class ObbNeighbors {
   double shell_;
   Box pbox_;
   bool lead_ = true;            // boxes led along the flight (set_lead)
+  bool short_windows_ = true;   // set_short_windows
+  std::uint64_t window_ends_ = 0;  // neighbour events at a window's end that kept the box
+  static constexpr std::uint32_t kWindowEnd = 6;  // the partner of such an event (faces: 0-5)
   std::uint64_t leads_ = 0;     // rebuilds that led the box
   // the clearance the secant aims at (after a free run; after a collision) and the least it
   // accepts, in units of shell - margin
