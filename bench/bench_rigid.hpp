@@ -80,8 +80,8 @@ struct RigidPoint {
   bool resort = false;     // a state carried over between simulations renumbered along a curve
 };
 
-// Reads shape, N, phi, X0, b, p, inertia, revolution, box_test, short_windows, memo, shuffle, resort, eps_d,
-// seed, method, shell.
+// Reads shape, N, phi, X0, b, p, inertia, revolution, box_test, short_windows, memo, shuffle,
+// resort, eps_d, seed, method, shell.
 // Defaults: the ellipsoids of bench_ellipsoids (b = 1/2, I = 2/5 m (smallest semi-axis)^2).
 inline RigidPoint read_point(Args& a) {
   RigidPoint pt;

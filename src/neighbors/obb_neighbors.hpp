@@ -286,8 +286,10 @@ class ObbNeighbors {
 
  public:
 
-  // Rebuild body i's box around its current pose (body already streamed to the event time) and
-  // update the lists it appears in. Returns false: predict i against its whole new list.
+  // Body i's neighbour event (body already streamed to the event time). At the end of a short
+  // window, i still inside its box: nothing changes. Otherwise: rebuild i's box around its
+  // current pose and update the lists it appears in. Returns false: predict i against its whole
+  // list.
   template <class Fn>
   bool handle(std::uint32_t i, const Event& ev, State& s, const Box& box, Fn&&) {
     if (ev.partner == kWindowEnd && short_windows_) {  // still inside: keep the box, predict anew
