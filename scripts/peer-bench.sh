@@ -277,7 +277,7 @@ med = statistics.median
 rows = []
 for n in sorted(plan):
     t1, t2, w = plan[n]
-    pr, orr, prss, orss, pcoll, ocoll, warn = [], [], [], [], [], [], []
+    pr, orr, prss, orss, pcoll, ocoll, oeng, warn = [], [], [], [], [], [], [], []
     for r in range(1, int(rounds) + 1):
         s, l, o = runs[("peer_short", n, r)], runs[("peer_long", n, r)], runs[("ours", n, r)]
         ls, ll = progress(s["log"]), progress(l["log"])
@@ -292,6 +292,8 @@ for n in sorted(plan):
             sys.exit("no JSON line from bench_hard_spheres: " + o["log"])
         orr.append(js[-1]["collisions_per_second"])
         ocoll.append(js[-1]["collisions"])
+        if "bytes_per_body" in js[-1]:
+            oeng.append(js[-1]["bytes_per_body"])
         prss.append(max(s["rss_kb"], l["rss_kb"]))
         orss.append(o["rss_kb"])
         pdt = dt; peq = c1
@@ -306,7 +308,8 @@ for n in sorted(plan):
         peer_T1=t1, peer_T2=t2, peer_write_interval=w,
         peer_max_rss_kb=max(prss), ours_max_rss_kb=max(orss),
         peer_bytes_per_body=max(prss) * 1024 / n, ours_bytes_per_body=max(orss) * 1024 / n,
-        ours_whole_process_cpu_s=ours_whole, timer=timer, warnings=warn))
+        ours_engine_bytes_per_body=max(oeng) if oeng else None,
+        ours_whole_process_cpu_s=ours_whole, timer=timer, date=datetime.date.today().isoformat(), warnings=warn))
 
 with open(os.path.join(outdir, "peer_hard_spheres.jsonl"), "w") as f:
     for r in rows:

@@ -98,6 +98,18 @@ def merge_rows(old_rows, new_rows, prefixes):
     return [r for r in old_rows if not matches(r.get("study", ""), prefixes)] + list(new_rows)
 
 
+def run_bench(cmd, who):
+    """Runs one benchmark process; returns its JSON lines and the CPU seconds it took (user + sys).
+    Exits with a message naming `who` when the process fails."""
+    t0 = os.times()
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    t1 = os.times()
+    cpu = (t1.children_user - t0.children_user) + (t1.children_system - t0.children_system)
+    if p.returncode != 0:
+        sys.exit(f"{who}: {' '.join(cmd)} failed ({p.returncode}): {p.stderr.strip()}")
+    return [json.loads(line) for line in p.stdout.splitlines() if line.startswith("{")], cpu
+
+
 class Runner:
     """Runs one benchmark per call and records its rows. only: study prefixes to run (None: all);
     stamp: fields added to every row (source, date); dry_run: print the commands, run nothing.
@@ -121,13 +133,8 @@ class Runner:
         if self.dry_run:
             print(f"[{study}] {' '.join([bench] + cmd[4:])}")
             return []
-        t0 = os.times()
-        p = subprocess.run(cmd, capture_output=True, text=True)
-        t1 = os.times()
-        self.cpu += (t1.children_user - t0.children_user) + (t1.children_system - t0.children_system)
-        if p.returncode != 0:
-            sys.exit(f"performance: {' '.join(cmd)} failed ({p.returncode}): {p.stderr.strip()}")
-        rows = [json.loads(line) for line in p.stdout.splitlines() if line.startswith("{")]
+        rows, cpu = run_bench(cmd, "performance")
+        self.cpu += cpu
         for r in rows:
             r["study"] = study
             r["command"] = " ".join([bench] + cmd[4:])

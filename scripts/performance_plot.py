@@ -23,6 +23,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker  # noqa: E402
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 # Thresholds of the issue-4 targets.
 TAU_TARGET_US = 25.0
@@ -1023,6 +1024,32 @@ def summary(rep):
         rep.figure("e_tau_vs_n.png", "tau_c vs N")
 
 
+def speed_targets(rep, path):
+    """The issue-15 table (bench/speed_targets.py), with the peer's figures, when it has been run."""
+    if not os.path.exists(path):
+        return
+    rows = [json.loads(line) for line in open(path)]
+    meta = next((r for r in rows if r.get("meta")), {})
+    rows = [r for r in rows if not r.get("meta")]
+    rep.w("## Issue-15 speed targets (hard spheres against the fastest public code, ellipsoids, superquadrics)", "",
+          f"From `{os.path.relpath(path, ROOT)}`, written by `{meta.get('command', 'bench/speed_targets.py')}` on "
+          f"{meta.get('date', '?')} (commit `{meta.get('commit', '?')}`); the hard-sphere rows set this code beside "
+          "F. Smallenburg's EDMD `Single` measured in the same alternating runs (`scripts/peer-bench.sh`, details and "
+          "per-round figures in `docs/benchmarks/peer_hard_spheres.md` and `docs/benchmarks/speed_targets.md`). "
+          "This report's own runs above are separate ones.", "")
+    def val(r):
+        v = r.get("value")
+        if v is None:
+            return "not measured"
+        s = f"{v:.3g}" if abs(v) < 100 else f"{v:.0f}"
+        if r.get("date") and r["date"] != meta.get("date"):
+            s += f" (run of {r['date']})"
+        return s
+    rep.table(["target", "measured", "threshold", "verdict"],
+              [[r["what"], val(r), r["threshold"],
+                "not measured" if r.get("met") is None else verdict(r["met"])] for r in rows])
+
+
 def main():
     out, md = sys.argv[1].rstrip("/"), sys.argv[2]
     rows = [json.loads(line) for line in open(os.path.join(out, "raw.jsonl"))]
@@ -1039,6 +1066,7 @@ def main():
     where_time_goes(body)
     rep.targets = body.targets
     summary(rep)
+    speed_targets(rep, os.path.join(ROOT, "docs", "benchmarks", "speed_targets.jsonl"))
     rep.w("## The figures one by one", "")
     rep.lines += body.lines
     rep.w("## Files", "",
