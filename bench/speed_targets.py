@@ -62,9 +62,8 @@ def keys(d):
 
 
 class Bench:
-    def __init__(self, quick):
-        self.quick = quick
-        self.cpu = 0.0
+    def __init__(self):
+        self.cpu = 0.0  # CPU seconds of the benchmark processes so far
 
     def run(self, exe, args, label):
         """Runs one benchmark process under nice; returns its last JSON line."""
@@ -334,7 +333,7 @@ def main():
             sys.exit(f"speed_targets: --only needs an earlier {jpath}")
         kept = [json.loads(x) for x in open(jpath) if not x.startswith('{"meta"')]
         kept = [r for r in kept if r.get("group", r["target"]) not in only]
-    bench = Bench(a.quick)
+    bench = Bench()
     load_before = os.getloadavg()[0]
     t0 = time.time()
     new = []
