@@ -8,7 +8,9 @@
 //   bounds from |w|, not from the spin across their axes: the slow twin)  box_test=1 (0: the
 //   neighbour lists' axis-aligned box pre-test off, where it would be on: the slow twin)
 //   short_windows=1 (0: the neighbour lists' escape searches over 8 circumradii' flight, with a
-//   rebuild at the window's end, not over a quarter and keeping the box: the slow twin)  memo=1
+//   rebuild at the window's end, not over a quarter and keeping the box: the slow twin)
+//   mean_free_cap=2 (short windows cut at this many times the body's mean time between
+//   collisions; 0: not cut, the slow twin)  memo=1
 //   (0: no pair's last separating axis kept after the start, every search cold: the slow twin)
 //   shuffle=0 (1: the lattice start's bodies numbered at random, not along its Morton curve)
 //   resort=0 (1: where a scan rebuilds the simulation from the state the point before ended

@@ -75,13 +75,14 @@ struct RigidPoint {
   bool revolution = true;  // the spheroids' spin-across bounds (false: the slow twin's |w|)
   bool box_test = true;    // the NNL's axis-aligned box test where it is on (false: off, the twin)
   bool short_windows = true;  // the NNL's short escape windows (false: long ones, the twin)
+  double mean_free_cap = 2.0;  // short windows cut at c mean free times (0: off, the twin)
   bool memo = true;        // each pair's last separating axis kept (false: every search cold)
   bool shuffle = false;    // bodies numbered at random, not along the lattice's Morton curve
   bool resort = false;     // a state carried over between simulations renumbered along a curve
 };
 
-// Reads shape, N, phi, X0, b, p, inertia, revolution, box_test, short_windows, memo, shuffle,
-// resort, eps_d, seed, method, shell.
+// Reads shape, N, phi, X0, b, p, inertia, revolution, box_test, short_windows, mean_free_cap,
+// memo, shuffle, resort, eps_d, seed, method, shell.
 // Defaults: the ellipsoids of bench_ellipsoids (b = 1/2, I = 2/5 m (smallest semi-axis)^2).
 inline RigidPoint read_point(Args& a) {
   RigidPoint pt;
@@ -110,6 +111,7 @@ inline RigidPoint read_point(Args& a) {
   pt.revolution = a.num("revolution", 1) != 0;
   pt.box_test = a.num("box_test", 1) != 0;
   pt.short_windows = a.num("short_windows", 1) != 0;
+  pt.mean_free_cap = a.num("mean_free_cap", 2.0);
   pt.memo = a.num("memo", 1) != 0;
   pt.shuffle = a.num("shuffle", 0) != 0;
   pt.resort = a.num("resort", 0) != 0;
@@ -406,6 +408,8 @@ void with_rigid_simulation(const RigidPoint& pt, Start st, F&& f) {
       if (!pt.box_test) sim.neighbors().set_box_test(false);  // off after init: nothing stale
     if constexpr (requires { sim.neighbors().set_short_windows(false); })
       sim.neighbors().set_short_windows(pt.short_windows);  // from the next escape search on
+    if constexpr (requires { sim.neighbors().set_mean_free_cap(0.0); })
+      sim.neighbors().set_mean_free_cap(pt.mean_free_cap);
     if constexpr (requires { sim.model().memo.on; }) sim.model().memo.on = pt.memo;
     f(std::move(sim));
   });
@@ -435,6 +439,7 @@ inline Json describe(const RigidPoint& pt) {
   j["revolution"] = pt.revolution;
   j["box_test"] = pt.box_test;
   j["short_windows"] = pt.short_windows;
+  j["mean_free_cap"] = pt.mean_free_cap;
   j["memo"] = pt.memo;
   j["shuffle"] = pt.shuffle;
   j["resort"] = pt.resort;

@@ -202,7 +202,7 @@ struct GrowthResult {
 // streams every body to the end of each stretch and calls rescale(state) (the thermostat; it
 // returns the kinetic energy removed), then continues with a fresh prediction. The state's time
 // stamps are taken as the start time 0; the result holds the synchronized state at t_stop, time
-// stamps reset to 0 (no overlap check here).
+// stamps and event counts reset to 0 (no overlap check here).
 template <class Model, class Rescale>
 GrowthResult run_growth(Model model, State st, const Box& box, const GrowthOptions& opt,
                         Rescale rescale) {
@@ -292,7 +292,9 @@ GrowthResult run_growth(Model model, State st, const Box& box, const GrowthOptio
   }
   res.time = t;
   if constexpr (requires { model.stats; }) res.stats = model.stats;
-  for (std::size_t i = 0; i < st.size(); ++i) st.t[i] = 0.0;  // time 0 of the continuing run
+  // time 0 of the continuing run, and no velocity change yet (State::count: the counts of a
+  // run count from its time 0; the neighbour lists' windows read them, neighbors/obb_neighbors.hpp)
+  for (std::size_t i = 0; i < st.size(); ++i) st.t[i] = 0.0, st.count[i] = 0;
   res.state = std::move(st);
   res.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t_wall).count();
