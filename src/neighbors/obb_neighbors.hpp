@@ -41,9 +41,12 @@
 //
 // Escape search: the box is shrunk by margin = min(0.01 inscribed radius, shell / 4) and the
 // grazing step is eps = margin (paper: epsilon_d^nnl ~ 1e-2 b), so a grazing exit that the
-// search misses leaves the body inside the real box. When no exit is found within
-// 8 * circumradius / K (K the body's speed bound; a spinning body may never leave), a rebuild is
-// scheduled at the end of that window anyway (harmless: a rebuild at any time is valid). For the
+// search misses leaves the body inside the real box. When no exit is found within the search
+// window (window_end: a quarter of the circumradius' flight at the body's speed bound K, cut at
+// twice its mean time between collisions; a spinning body may never leave), the body is
+// predicted anew at the window's end and keeps its box (with set_short_windows(false): 8
+// circumradii' flight and a rebuild there; harmless either way, a rebuild at any time is valid,
+// and so is a new prediction). For the
 // same reason the root of the exit face is not refined to a few ulps: its bracket stops once the
 // body is within margin / 10 of the shrunken face (FirstRootOptions::value_tol), a rebuild at
 // most that distance's travel early (measured: 10 % of a superquadric collision at phi = 0.256).
