@@ -19,6 +19,7 @@
 // double-precision record).
 #pragma once
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -121,6 +122,14 @@ class CellMembers {
     const float f = static_cast<float>(x);
     return double(f) >= x ? f : f * (1.0f + 0x1p-23f);
   }
+  // std::nextafter(f, inf) for f >= +0 (not NaN), bit for bit and inline: the next float up is
+  // the next bit pattern (+0 -> the least subnormal, the largest finite -> inf); inf stays inf.
+  // libm's out-of-line call cost ~30 instructions a walk, one walk a cell visited (~2.5k
+  // instructions a collision for superquadrics at phi = 0.256, ~1 %).
+  static float next_up(float f) {
+    if (!(f < std::numeric_limits<float>::infinity())) return f;
+    return std::bit_cast<float>(std::bit_cast<std::uint32_t>(f) + 1u);
+  }
 
  private:
   template <bool kBoxes, class Fn>
@@ -134,7 +143,7 @@ class CellMembers {
     for (int k = 0; k < 3; ++k)
       if (std::isfinite(period[k])) pmax = std::max(pmax, period[k]);
     const double r = reach + 1e-5 * (scale + pmax);
-    const float r2 = std::nextafter(static_cast<float>(r * r), std::numeric_limits<float>::infinity());
+    const float r2 = next_up(static_cast<float>(r * r));
     const F4 f = {float(from[0]), float(from[1]), float(from[2]), 0.0f};
     const double slack = 1e-5 * (scale + pmax);  // the distance's widening, along each axis
     const F4 hq = {up(half[0] + slack), up(half[1] + slack), up(half[2] + slack), 0.0f};

@@ -8,7 +8,11 @@
 #include <gtest/gtest.h>
 
 #include <pcg_random.hpp>
+#include <bit>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <random>
 #include <set>
 #include <tuple>
@@ -215,4 +219,25 @@ TEST(CellMembers, WalkSkipsTheMembersWhoseBoxesLieApart) {
   EXPECT_GT(reported, 1000u);
   EXPECT_GT(skipped_by_boxes, 1000u);
   EXPECT_GT(near_face, 500u);
+}
+
+// The walk's reach in single precision is rounded up by CellMembers::next_up, the inline twin of
+// std::nextafter(f, inf): the same bits on every kind of non-negative float (zero, subnormals,
+// the normal range across binades, the largest finite, inf) and on random squares of reaches.
+TEST(CellMembers, NextUpIsNextafterBitForBit) {
+  const float inf = std::numeric_limits<float>::infinity();
+  std::vector<float> xs = {0.0f, std::numeric_limits<float>::denorm_min(),
+                           std::numeric_limits<float>::min(), 1.0f, 0.999999940f,
+                           std::numeric_limits<float>::max(), inf};
+  for (int e = -149; e <= 127; ++e) xs.push_back(std::ldexp(1.0f, e));
+  pcg32 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 30.0);
+  for (int n = 0; n < 100000; ++n) {
+    const double r = u(rng);
+    xs.push_back(static_cast<float>(r * r));
+  }
+  for (const float x : xs)
+    EXPECT_EQ(std::bit_cast<std::uint32_t>(CellMembers::next_up(x)),
+              std::bit_cast<std::uint32_t>(std::nextafter(x, inf)))
+        << x;
 }
