@@ -73,9 +73,7 @@ inline Vec3 half_extents(const AnyShape& s) {
 // body i of a species is its shape resized by scale_i).
 inline Sphere resized(const Sphere& x, double s) { return Sphere{x.radius * s}; }
 inline Ellipsoid resized(const Ellipsoid& x, double s) { return Ellipsoid{x.a * s, x.b * s, x.c * s}; }
-inline Superquadric resized(const Superquadric& x, double s) {
-  return Superquadric(x.a * s, x.b * s, x.c * s, x.n, x.m, x.p);
-}
+inline Superquadric resized(const Superquadric& x, double s) { return x.resized(s); }
 inline AnyShape resized(const AnyShape& x, double s) {
   return std::visit([s](const auto& y) { return AnyShape(resized(y, s)); }, x);
 }

@@ -85,7 +85,9 @@ concept BoundedCurvature = requires { requires S::kBoundedCurvature; };
 // a gap (contact/contact_time.hpp, contact/axis_gap.hpp, contact/escape_time.hpp). For any
 // shape, |x|^2 = (x.m)^2 + |x x m|^2 with x.m = h(m) >= r_in (the ball of the inscribed radius
 // about the centre lies in the body) and |x| <= L, so l <= sqrt(L^2 - r_in^2); shapes with a
-// closed form declare `rotation_lever()` (ellipsoids: a_max - a_min; spheres: 0).
+// closed form declare `rotation_lever()` (ellipsoids: a_max - a_min; spheres: 0), and so do
+// superquadrics, from a branch and bound computed once per shape (sq_detail::lever_bound, within
+// 1e-3 of the lever: 1.185 against the generic 1.769 for (0.8, 1.6, 1.6) with exponents (2, 2, 8)).
 inline double rotation_lever_bound(double L, double r_in) {  // sqrt(L^2 - r_in^2)
   return std::sqrt(std::max(0.0, (L - r_in) * (L + r_in)));
 }
