@@ -197,18 +197,18 @@ const FlatStartTable& flat_start_table() {
 //      largest |psi_i| on [lo, hi] is at an end or where psi_i' = 0,
 //      t* = (a_i^2 / (mu e_i (e_i - 1)))^(1/(e_i-2)) (e_i > 2; psi_i is linear when e_i = 2).
 //      mu is the minimiser x.g / |g|^2 at the box's centre, so the bound is exact there and
-//      close to the function on small boxes (measured: 268 boxes split for the (2, 2, 8) body of
-//      the benchmarks at rtol = 1e-3 with the least of (1) and (2), 27000 with (1) alone).
+//      close to the function on small boxes (measured on the (2, 2, 8) body of the benchmarks:
+//      39 boxes split at rtol = 1e-2 with the least of (1) and (2), 2833 with (1) alone; 266 at
+//      rtol = 1e-3).
 // The box of the largest bound is split in four and the function evaluated at its centre, until
 // the largest bound is within (1 + rtol)^2 of the best value found, or max_boxes boxes have been
 // split.  Whatever the stop, the largest bound of the boxes left or dropped bounds the maximum
-// (rigorously up to the rounding of the formulas, which the absolute 1e-12 L^2 covers: every
-// term is at most L^2 or its square root).  Returned: the square root of that bound, within a
+// (rigorously up to the rounding of the formulas, which the absolute 1e-12 |a|^2 covers: every
+// term is at most L^2 <= |a|^2 or its square root).  The caller scales the body to a_max = 1.  Returned: the square root of that bound, within a
 // factor 1 + rtol of the lever when the search ends by the tolerance; the caller takes the
 // least of it and the generic sqrt(L^2 - r_in^2).  (0.8, 1.6, 1.6) with exponents (2, 2, 8):
 // 1.1854 (the lever ~1.1843; the generic bound 1.769); (2, 2, 4): 0.9816 (generic 1.600).
-inline double lever_bound(const Vec3& ax, const Vec3& e, double L, double rtol = 1e-3,
-                          int max_boxes = 20000) {
+inline double lever_bound(const Vec3& ax, const Vec3& e, double rtol = 1e-3, int max_boxes = 20000) {
   Vec3 ca, cg, pg;  // a_i^2, e_i^2/a_i^2, 2e_i - 2
   for (int i = 0; i < 3; ++i) {
     ca[i] = ax[i] * ax[i];
@@ -289,7 +289,8 @@ inline double lever_bound(const Vec3& ax, const Vec3& e, double L, double rtol =
       }
   }
   const double top = std::max({best, dropped, heap.empty() ? 0.0 : heap.top().ub});
-  return std::sqrt(std::max(0.0, top) + 1e-12 * L * L);
+  const double L2 = ax.squaredNorm();  // >= |x|^2 on the surface (t_i <= 1)
+  return std::sqrt(std::max(0.0, top) + 1e-12 * L2);
 }
 }  // namespace sq_detail
 
@@ -323,9 +324,9 @@ struct Superquadric {
     const Vec3 e = exponents(), ax = r.axes();
     for (int i = 0; i < 3; ++i) r.a_over_e_[i] = ax[i] / e[i];
     r.bounding_radius_ = r.farthest_point().norm() * (1.0 + 1e-12);
-    const double generic = rotation_lever_bound(r.bounding_radius_, ax.minCoeff());
-    r.lever_ = two_[0] && two_[1] && two_[2] ? ax.maxCoeff() - ax.minCoeff()
-                                              : std::min(lever_ * s, generic);
+    const double scaled = lever_ * s;  // searched again only if that is not finite
+    r.set_lever(two_[0] && two_[1] && two_[2] ? 0.0
+                : std::isfinite(scaled) && scaled > 0.0 ? scaled : r.searched_lever());
     return r;
   }
 
@@ -597,12 +598,26 @@ struct Superquadric {
     }
     equal_q_ = q_[0] == q_[1] && q_[1] == q_[2];
     bounding_radius_ = farthest_point().norm() * (1.0 + 1e-12);
+    set_lever(two_[0] && two_[1] && two_[2] ? 0.0 : searched_lever());
+  }
+  // The branch and bound for the body scaled to a_max = 1 (its squares stay finite at any
+  // size), scaled back.
+  double searched_lever() const {
+    const Vec3 ax = axes();
+    const double mx = ax.maxCoeff();
+    return mx * sq_detail::lever_bound(ax / mx, exponents());
+  }
+  // The ellipsoid's closed form, else the searched lever capped by the generic bound (when the
+  // bounding radius is finite: at 1e200 it is not, and the generic bound would read 0).
+  void set_lever(double searched) {
+    const Vec3 ax = axes();
     const double mx = ax.maxCoeff(), mn = ax.minCoeff();
     if (two_[0] && two_[1] && two_[2]) {
       lever_ = mx - mn;
+    } else if (std::isfinite(bounding_radius_)) {
+      lever_ = std::min(searched, rotation_lever_bound(bounding_radius_, mn));
     } else {
-      lever_ = std::min(sq_detail::lever_bound(ax, e, bounding_radius_),
-                        rotation_lever_bound(bounding_radius_, mn));
+      lever_ = searched;
     }
   }
   Vec3 grad_of(const Vec3& x, const Powers& P) const {

@@ -252,6 +252,14 @@ TEST(Shapes, SuperquadricResizedScalesTheLever) {
     }
   }
   EXPECT_EQ(Superquadric(1.0, 0.5, 0.5, 2, 2, 2).resized(3.0).rotation_lever(), 1.5);
+  // the search runs on the body scaled to a_max = 1: the same lever, scaled, at any size (its
+  // squares would overflow at 1e200 and vanish at 1e-200)
+  const Superquadric q{0.8, 1.6, 1.6, 2, 2, 8};
+  for (const double s : {1e200, 1e-200, 0x1p1000, 0x1p-1000}) {
+    const Superquadric big{0.8 * s, 1.6 * s, 1.6 * s, 2, 2, 8};
+    EXPECT_NEAR(big.rotation_lever() / s, q.rotation_lever(), 1e-12 * q.rotation_lever()) << s;
+    EXPECT_NEAR(q.resized(s).rotation_lever() / s, q.rotation_lever(), 1e-12 * q.rotation_lever()) << s;
+  }
 }
 
 }  // namespace
