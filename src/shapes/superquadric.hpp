@@ -104,78 +104,119 @@ inline double log_root(const Vec3& k, const Vec3& v) {
   return s;
 }
 
-// The start of the (2, 2, p) support-point solver (Superquadric::flat_support_point): the root
-// x(K) in [0, 1] of x^p + K x^(2p-2) = 1, K >= 0, fitted once per integer p in 3..16.  Each
-// binade [2^E, 2^(E+1)) of 1 + K is cut into 2^kBits segments by the leading mantissa bits, and
-// on each segment x is the quartic interpolant at 5 Chebyshev nodes of the local coordinate u
-// in [0, 1) (the remaining mantissa bits), so the lookup needs no log or pow: the segment index
-// and u are bit fields of 1 + K.  Beyond kBinades binades x = 2^(-E/(2p-2)) (1 + m)^(-1/(2p-2))
-// to within 1e-9 (the x^p term is then negligible), fitted the same way once and scaled.
-// Measured over every segment (tests/shapes/test_superquadric.cpp): within 6e-8 of the root for
-// every p, worst in the first binade (K < 1); so Halley's first step from it is below the
-// solver's stop (1e-6 x) and the support point costs one evaluation of the polynomial.
-struct FlatStartTable {
-  static constexpr int kBits = 3, kBinades = 56, kCoef = 5;
+// The root of the (2, 2, p) support-point equation (Superquadric::flat_support_point): x(K) in
+// (0, 1] with x^p + K x^(2p-2) = 1, K >= 0, tabulated once per integer p in 3..16 to a few ulps,
+// so a support point needs no iteration.  x is a smooth function of the one number z = 1 + K,
+// cut at the bits of z: each binade [2^E, 2^(E+1)) (1 <= E < kBinades) into 2^kBits segments by
+// the leading mantissa bits, the first binade (K < 1) into 2^kBits0, and on each segment x is
+// the degree-8 interpolant at 9 Chebyshev nodes of the local coordinate u in [0, 1) (the
+// remaining mantissa bits), evaluated by Estrin's scheme: no log, pow or division.  The first
+// binade needs the finer cut: x(K) has a branch point at K ~ -0.3 (where G and G' vanish
+// together: x^p = (2p-2)/(p-2), |K| = p / ((2p-2) x^(p-2))), 0.3 from it, against ~1.3 binade
+// widths for the others.  Beyond kBinades binades, with x0 = z^(-1/(2p-2)) = 2^(-E/(2p-2)) (1 +
+// m)^(-1/(2p-2)) (one fitted segment set, scaled), x = x0 (1 - x0^p / (2p-2)): with
+// eps = x0^p the root is x0 w, w^(2p-2) + eps w^p = 1, w = 1 - eps / (2p-2) + 3 eps^2 /
+// (2 (2p-2)^2) + ..., and eps <= 2^(-56 p / (2p-2)) < 2^-29 there, so the neglected term is
+// below 1e-18.  The nodes' roots are solved in long double (Newton from the right, from x0,
+// where G(x0) = x0^p - x0^(2p-2) >= 0) and the coefficients fitted in long double, so the
+// table's error is its fit (measured below 3e-17 before rounding for p = 3, 8, 16) plus the
+// rounding of the stored coefficients and of the evaluation.  Measured over every segment
+// (tests/shapes/test_superquadric.cpp, FlatRootTableIsWithinAFewUlps): within 3.3e-16 for every
+// p.  This replaced a quartic start within 6e-8 followed by one Halley step (the same accuracy,
+// ~40 instructions and a division more per point).  Size: (32 + 55 * 16 + 16) * 9 doubles,
+// 66 KB per p, of which a run touches the few binades its directions use.
+struct FlatRootTable {
+  static constexpr int kBits = 4, kBits0 = 5, kBinades = 56, kCoef = 9;
+  static constexpr int kNear = (1 << kBits0) + (kBinades - 1) * (1 << kBits);
   int p = 0;
-  double near[kBinades << kBits][kCoef];
+  double inv_q = 0.0;        // 1 / (2p - 2)
+  double near[kNear][kCoef];
   double far[1 << kBits][kCoef];
   double scale[32];  // 2^(-r/(2p-2)), r < 2p - 2 <= 30
-  double guess(double K) const {
+  static double estrin(const double* c, double u) {
+    const double u2 = u * u, u4 = u2 * u2;
+    const double a = (c[0] + c[1] * u) + u2 * (c[2] + c[3] * u);
+    const double b = (c[4] + c[5] * u) + u2 * (c[6] + c[7] * u);
+    return a + u4 * (b + u4 * c[8]);
+  }
+  double root(double K) const {
     const double z = 1.0 + K;
     std::uint64_t bits;
     std::memcpy(&bits, &z, 8);
     const int e = static_cast<int>(bits >> 52) - 1023;  // >= 0: z >= 1
-    const int j = static_cast<int>(bits >> (52 - kBits)) & ((1 << kBits) - 1);
-    constexpr std::uint64_t kLow = (std::uint64_t{1} << (52 - kBits)) - 1;
-    const double u = static_cast<double>(bits & kLow) * (1.0 / static_cast<double>(kLow + 1));
-    const double* c = e < kBinades ? near[(e << kBits) + j] : far[j];
-    const double x = c[0] + u * (c[1] + u * (c[2] + u * (c[3] + u * c[4])));
-    if (e < kBinades) return x;
-    const int q = e / (2 * p - 2), r = e - q * (2 * p - 2);
-    return std::ldexp(x * scale[r], -q);
+    const bool first = e == 0;
+    const int shift = 52 - (first ? kBits0 : kBits);
+    const int j = static_cast<int>((bits & ((std::uint64_t{1} << 52) - 1)) >> shift);
+    const double u = static_cast<double>(bits & ((std::uint64_t{1} << shift) - 1)) *
+                     (first ? 0x1p-47 : 0x1p-48);
+    if (e < kBinades) return estrin(near[first ? j : (1 << kBits0) + ((e - 1) << kBits) + j], u);
+    // 2^-d from its bits (d <= 1024 / 4: a normal number), not std::ldexp: a call here would
+    // make the callers' hot path save registers
+    const int q = 2 * p - 2, d = e / q, r = e - d * q;
+    const std::uint64_t pow2 = static_cast<std::uint64_t>(1023 - d) << 52;
+    double two_d;
+    std::memcpy(&two_d, &pow2, 8);
+    const double x0 = estrin(far[j], u) * scale[r] * two_d;
+    double xp = 1.0;
+    for (int k = 0; k < p; ++k) xp *= x0;
+    return x0 - x0 * xp * inv_q;
   }
 };
-inline FlatStartTable make_flat_start_table(int p) {
-  FlatStartTable t;
+inline FlatRootTable make_flat_root_table(int p) {
+  using LD = long double;
+  FlatRootTable t;
   t.p = p;
-  const double a = 1.0 / (2.0 * p - 2.0);
-  constexpr int n = FlatStartTable::kCoef, segs = 1 << FlatStartTable::kBits;
-  Eigen::Matrix<double, n, 1> u;
-  Eigen::Matrix<double, n, n> V;
+  const int q = 2 * p - 2;
+  t.inv_q = 1.0 / q;
+  constexpr int n = FlatRootTable::kCoef;
+  using VecL = Eigen::Matrix<LD, n, 1>;
+  using MatL = Eigen::Matrix<LD, n, n>;
+  VecL u;
+  MatL V;
   for (int i = 0; i < n; ++i) {
-    u[i] = 0.5 * (1.0 - std::cos(std::numbers::pi * (i + 0.5) / n));
-    for (int k = 0; k < n; ++k) V(i, k) = std::pow(u[i], k);
+    u[i] = 0.5L * (1.0L - std::cos(std::numbers::pi_v<LD> * (i + 0.5L) / n));
+    for (int k = 0; k < n; ++k) V(i, k) = std::pow(u[i], LD(k));
   }
-  const Eigen::Matrix<double, n, n> Vinv = V.fullPivLu().inverse();
-  auto root = [p](double K) {  // bisection: G(0) = -1 < 0 <= G(1) = K
-    double lo = 0.0, hi = 1.0;
-    for (int it = 0; it < 200; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      if (!(mid > lo && mid < hi)) break;
-      const double G = std::pow(mid, p) + K * std::pow(mid, 2 * p - 2) - 1.0;
-      (G > 0.0 ? hi : lo) = mid;
+  const Eigen::FullPivLU<MatL> lu(V);  // (solved per segment: an explicit inverse loses 1e-14)
+  // Newton from the right: G is convex and increasing on [0, 1] and G(x0) >= 0, so the iterates
+  // fall monotonically to the root; stop when rounding stops them
+  auto root = [p, q](LD K) {
+    LD x = std::min(LD(1), std::pow(1.0L + K, LD(-1) / q));
+    for (int it = 0; it < 500; ++it) {
+      LD xp1 = 1;
+      for (int k = 0; k < p - 1; ++k) xp1 *= x;
+      const LD w3 = xp1 * x, w12 = K * xp1 * xp1;
+      const LD G = w3 + w12 - 1, g1 = p * w3 + q * w12;  // g1 = x G'
+      if (!(G > 0) || !(g1 > 0)) break;
+      const LD next = x - x * G / g1;
+      if (!(next < x)) break;
+      x = next;
     }
-    return 0.5 * (lo + hi);
+    return x;
   };
-  Eigen::Matrix<double, n, 1> v, c;
-  for (int E = 0; E < FlatStartTable::kBinades; ++E)
+  auto store = [&](double* c, const VecL& v) {
+    const VecL cf = lu.solve(v);
+    for (int k = 0; k < n; ++k) c[k] = static_cast<double>(cf[k]);
+  };
+  VecL v;
+  for (int E = 0; E < FlatRootTable::kBinades; ++E) {
+    const int segs = 1 << (E == 0 ? FlatRootTable::kBits0 : FlatRootTable::kBits);
     for (int j = 0; j < segs; ++j) {
-      for (int i = 0; i < n; ++i)
-        v[i] = root(std::ldexp(1.0 + (j + u[i]) / segs, E) - 1.0);
-      c = Vinv * v;
-      for (int k = 0; k < n; ++k) t.near[E * segs + j][k] = c[k];
+      for (int i = 0; i < n; ++i) v[i] = root(std::ldexp(1.0L + (j + u[i]) / segs, E) - 1.0L);
+      store(t.near[E == 0 ? j : (1 << FlatRootTable::kBits0) + ((E - 1) << FlatRootTable::kBits) + j], v);
     }
-  for (int j = 0; j < segs; ++j) {
-    for (int i = 0; i < n; ++i) v[i] = std::pow(1.0 + (j + u[i]) / segs, -a);
-    c = Vinv * v;
-    for (int k = 0; k < n; ++k) t.far[j][k] = c[k];
   }
-  for (int r = 0; r < 32; ++r) t.scale[r] = std::exp2(-r * a);
+  constexpr int fsegs = 1 << FlatRootTable::kBits;
+  for (int j = 0; j < fsegs; ++j) {
+    for (int i = 0; i < n; ++i) v[i] = std::pow(1.0L + (j + u[i]) / fsegs, LD(-1) / q);
+    store(t.far[j], v);
+  }
+  for (int r = 0; r < 32; ++r) t.scale[r] = static_cast<double>(std::exp2(-LD(r) / q));
   return t;
 }
 template <int P>
-const FlatStartTable& flat_start_table() {
-  static const FlatStartTable t = make_flat_start_table(P);
+const FlatRootTable& flat_root_table() {
+  static const FlatRootTable t = make_flat_root_table(P);
   return t;
 }
 // The rotation lever of a superquadric (shapes/shape.hpp): an upper bound of |x x n| over the
@@ -511,10 +552,10 @@ struct Superquadric {
     }
     return H - rx * rx.transpose() / (lambda * W);
   }
-  // (2, 2, p) bodies with integer p in 3..16: the start of their support-point solver, the
-  // tabulated root of x^p + K x^(2p-2) = 1 (sq_detail::FlatStartTable; the tests bound its error)
-  bool has_flat_guess() const { return flat_table_ != nullptr; }
-  double flat_guess(double K) const { return flat_table_->guess(K); }
+  // (2, 2, p) bodies with integer p in 3..16: the root of x^p + K x^(2p-2) = 1 their
+  // support-point solver takes from a table (sq_detail::FlatRootTable; the tests bound its error)
+  bool has_flat_root_table() const { return flat_table_ != nullptr; }
+  double flat_root(double K) const { return flat_table_->root(K); }
   // (u^T H u, u^T H v, v^T H v) for H = support_hessian(d), given the support point x =
   // support_point(d): no second root solve and no matrix (contact/axis_gap.hpp).  The multiplier
   // comes from x itself: d_i x_i = lambda e_i t_i^e_i, so lambda = h / sum e_i t_i^e_i (h = d.x).
@@ -555,7 +596,7 @@ struct Superquadric {
   // flat_support_point for this p (unrolled powers for p <= 16), or null: not (2, 2, p)
   using FlatSolver = bool (Superquadric::*)(const Vec3&, const Vec3&, Vec3&, double&) const;
   FlatSolver flat_ = nullptr;
-  const sq_detail::FlatStartTable* flat_table_ = nullptr;  // p <= 16: the solver's start
+  const sq_detail::FlatRootTable* flat_table_ = nullptr;  // p <= 16: the solver's root
   bool equal_q_ = true;
   // t^k for 0 <= k <= 62 by repeated squaring (at most 11 multiplications, no pow)
   static double int_power(double t, int k) {
@@ -629,95 +670,64 @@ struct Superquadric {
       g[i] = std::copysign(e[i] / (E * ax[i]) * P.d1[i], x[i]);
     return g;
   }
-  // The Halley start: the table's guess for p <= 16, else (1 + K)^(-1/(2p-2)) in single
-  // precision (within a factor 2^(-1/p) of the root; about 2.2 evaluations of G per point).
-  template <int PM1>
+  // The Halley start above p = 16: (1 + K)^(-1/(2p-2)) in single precision (within a factor
+  // 2^(-1/p) of the root; about 2.2 evaluations of G per point).
   double flat_start(double K) const {
-    if constexpr (PM1 > 0) {
-      return flat_guess(K);
-    } else {
-      if (K < 1e37) return std::pow(static_cast<float>(1.0 + K), -static_cast<float>(inv_2p_2_));
-      return std::pow(1.0 + K, -inv_2p_2_);
-    }
+    if (K < 1e37) return std::pow(static_cast<float>(1.0 + K), -static_cast<float>(inv_2p_2_));
+    return std::pow(1.0 + K, -inv_2p_2_);
   }
   // The support point of a (2, 2, p) body with integer p (axis k = flat_axis_ has exponent p)
   // without a power per iteration.  The Lagrange conditions t_i = (c_i y)^(1/(e_i-1)) give, in
   // x = t_k, y = x^(p-1) / c_k and t_i = c_i y on the two exponent-2 axes, so the constraint
   // t_i^2 + t_j^2 + x^p = 1 becomes the polynomial equation
   //     G(x) = x^p + K x^(2p-2) - 1 = 0,     K = (c_i^2 + c_j^2) / c_k^2,
-  // convex and increasing on [0, 1], with powers by squaring (unrolled at compile time for
-  // p <= 16: pick_flat_solver picks the instance once per shape).  Start (flat_start): for p <= 16
-  // the tabulated root (sq_detail::FlatStartTable, within 6e-8), so the first Halley step is
-  // already below the stop and a point costs one evaluation of G (2.5 from the closed-form
-  // start (1 + K)^(-1/(2p-2)) used before, measured at p = 8 over directions uniform on the
-  // sphere); above p = 16 that closed form (G(x0) >= 0 since x^(2p-2) <= x^p on [0, 1], the root
-  // within a factor 2^(-1/p) below) in single precision.  Halley steps with x-scaled
-  // derivatives (they come back from either side of the root), stopped as in the general solver
-  // after a step below 1e-6 x.  The one division after the start is Halley's: y = x^(p-1) / c_k
-  // multiplies by 1 / c_k (taken beside K) and lambda = 1/y comes from the root itself, so the
-  // chain of dependent divisions (36 % of this function's samples in the p = 8 profile)
-  // is two long instead of four.
-  // Returns false (the caller takes the general path) when d_k = 0 (or subnormal) or K is
-  // beyond 1e250.
-  // The axis of exponent p is a template parameter too (AX = flat_axis_), so the three axes are
-  // indexed at compile time; with the table's start (p <= 16) the first Halley step is taken
-  // without the loop's tests: the start is within 2e-7 of the root (the tests bound it), so the
-  // step is always below the stop (a larger one, which the table's tests rule out, falls back
-  // to the loop from the same start). The results are bit for bit those of the loop.
-  // Measured on the (2, 2, 8) protocol (docs/benchmarks/README.md, "Session of 2026-12-05,
-  // third part"): 177 -> 151 instructions a point, -2.5 % of the run's instructions and time.
+  // convex and increasing on [0, 1].  For p <= 16 the root is read from a table to a few ulps
+  // (sq_detail::FlatRootTable; pick_flat_solver picks the instance, with x^(p-1) unrolled, once
+  // per shape): no iteration.  Above p = 16 Halley steps with x-scaled derivatives (they come
+  // back from either side of the root) from the closed-form start (flat_start: G(x0) >= 0 since
+  // x^(2p-2) <= x^p on [0, 1], the root within a factor 2^(-1/p) below), stopped as in the
+  // general solver after a step below 1e-6 x.  Then y = 1/lambda = x^(p-1) / c_k multiplies by
+  // 1 / c_k (taken beside K) and lambda = 1/y comes from the root itself, so the only division
+  // on the chain is K's.  Returns false (the caller takes the general path) when d_k = 0 (or
+  // subnormal) or K is beyond 1e250.  The axis of exponent p is a template parameter too
+  // (AX = flat_axis_), so the three axes are indexed at compile time.  Measured on the (2, 2, 8)
+  // protocol (docs/benchmarks/README.md, "Session of 2026-12-06, third part"): the quartic start
+  // and one Halley step cost 151 instructions a point, the table's root alone 112 (no call is
+  // left in this function, so it saves no registers).
   template <int PM1, int AX>  // p - 1 (0: p - 1 read from ie_ at run time); the axis of p
   bool flat_support_point(const Vec3& d, const Vec3& cc, Vec3& x_out, double& lambda) const {
     constexpr int k = AX, i = (AX + 1) % 3, j = (AX + 2) % 3;
-    const int pm1 = PM1 > 0 ? PM1 : ie_[k] + 1;
-    auto power = [pm1](double t) {
-      if constexpr (PM1 > 0) return int_power_of<PM1>(t);
-      else return int_power(t, pm1);
-    };
-    const double ck = cc[k], p = static_cast<double>(pm1 + 1);
+    const double ck = cc[k];
     if (!(ck >= std::numeric_limits<double>::min())) return false;  // 1 / c_k finite
     const double rk = 1.0 / ck;  // off the chain: y = x^(p-1) / c_k below is a product
     const double K = (cc[i] * cc[i] + cc[j] * cc[j]) / (ck * ck);
     if (!(K <= 1e250)) return false;
-    double x = flat_start<PM1>(K), xp1 = 0.0;
-    // One Halley step from x: G(x) and its x-scaled derivatives, the step in units of x
-    // (Newton's step G / g1 instead where Halley's is over half of x: G / g1 < 1 keeps x > 0)
-    auto halley = [&]() {
-      xp1 = power(x);  // x^(p-1)
-      const double w3 = xp1 * x, w12 = K * xp1 * xp1;
-      const double G = w3 + w12 - 1.0;
-      const double g1 = p * w3 + (2.0 * p - 2.0) * w12;  // x G'
-      const double g2 = p * (p - 1.0) * w3 + (2.0 * p - 2.0) * (2.0 * p - 3.0) * w12;  // x^2 G''
-      const double delta = 2.0 * G * g1 / (2.0 * g1 * g1 - G * g2);
-      return std::abs(delta) < 0.5 ? delta : G / g1;
-    };
-    // x^(p-1) carried over the last step by (1 - delta)^(p-1) to second order: the error
-    // C(p-1, 3) delta^3 is below 1e-15 for p <= 16, |delta| <= 1e-6 (the table's start leaves
-    // |delta| < 2e-7: ~1e-18)
-    auto carry = [&](double delta) {
-      const double c1 = static_cast<double>(PM1), c2 = 0.5 * c1 * (c1 - 1.0);
-      xp1 *= 1.0 + delta * (c2 * delta - c1);
-    };
-    bool done = false;
+    double x, xp1;  // the root and x^(p-1)
     if constexpr (PM1 > 0) {
-      const double delta = halley();
-      const double step = delta * x;
-      if (std::abs(step) <= 1e-6 * (x - step)) {  // the loop's stop, on the same numbers
+      x = flat_table_->root(K);
+      xp1 = int_power_of<PM1>(x);
+    } else {
+      const int pm1 = ie_[k] + 1;
+      const double p = static_cast<double>(pm1 + 1);
+      x = flat_start(K);
+      xp1 = 0.0;
+      for (int it = 0; it < 100; ++it) {
+        // one Halley step from x: G(x) and its x-scaled derivatives, the step in units of x
+        // (Newton's step G / g1 instead where Halley's is over half of x: G / g1 < 1 keeps
+        // x > 0)
+        xp1 = int_power(x, pm1);
+        const double w3 = xp1 * x, w12 = K * xp1 * xp1;
+        const double G = w3 + w12 - 1.0;
+        const double g1 = p * w3 + (2.0 * p - 2.0) * w12;  // x G'
+        const double g2 = p * (p - 1.0) * w3 + (2.0 * p - 2.0) * (2.0 * p - 3.0) * w12;
+        double delta = 2.0 * G * g1 / (2.0 * g1 * g1 - G * g2);
+        if (!(std::abs(delta) < 0.5)) delta = G / g1;
+        if (!(std::abs(delta) > 0.0)) break;
+        const double step = delta * x;
         x -= step;
-        carry(delta);
-        done = true;
+        if (std::abs(step) <= 1e-6 * x) break;
       }
-    }
-    for (int it = 0; !done && it < 100; ++it) {
-      const double delta = halley();
-      if (!(std::abs(delta) > 0.0)) break;
-      const double step = delta * x;
-      x -= step;
-      if (std::abs(step) <= 1e-6 * x) {
-        if constexpr (PM1 > 0) carry(delta);
-        else xp1 = power(x);
-        break;
-      }
+      xp1 = int_power(x, pm1);
     }
     // y = 1/lambda = x^(p-1) / c_k, and lambda without a division: dividing G(x) = 0 by
     // x^(p-1) gives 1 / x^(p-1) = x + K x^(p-1) at the root
@@ -734,7 +744,7 @@ struct Superquadric {
     else if constexpr (I == 1) return b;
     else return c;
   }
-  // The solver instance and the start table for p and the axis k of p (flat_support_point<p - 1,
+  // The solver instance and the root table for p and the axis k of p (flat_support_point<p - 1,
   // k> and the table of p for p = 3..16; above, the run-time instance and no table), picked once
   // per shape.
   template <int AX>
@@ -743,7 +753,7 @@ struct Superquadric {
     flat_table_ = nullptr;
     [&]<int... I>(std::integer_sequence<int, I...>) {
       ((p == I + 3 ? (flat_ = &Superquadric::flat_support_point<I + 2, AX>,
-                      flat_table_ = &sq_detail::flat_start_table<I + 3>(), 0)
+                      flat_table_ = &sq_detail::flat_root_table<I + 3>(), 0)
                    : 0),
        ...);
     }(std::make_integer_sequence<int, 14>{});

@@ -319,18 +319,23 @@ TEST(Superquadric, FlatAxisSupportPointMatchesBisection) {
               worst_par, worst_h);
 }
 
-// The (2, 2, p) solver's start (sq_detail::FlatStartTable) against a long-double bisection of
-// x^p + K x^(2p-2) = 1, for every p it is fitted for (3..16), at 9 points of every segment of
-// the fitted binades (K from 0 to 2^56) and of binades far beyond (up to K ~ 1e250, where the
-// start is the scaled asymptote).  Its error must stay below 2e-7 so that the first Halley step
-// (~ the error) is below the solver's stop at 1e-6 x: one evaluation per support point.
-TEST(Superquadric, FlatSolverStartIsWithin2e7OfTheRoot) {
+// The (2, 2, p) solver's root (sq_detail::FlatRootTable) against a long-double bisection of
+// x^p + K x^(2p-2) = 1, for every p it is fitted for (3..16), at 6 points of every segment
+// of the fitted binades (K from 0 to 2^56: 32 segments in the first, 16 in the others), and
+// of every segment of binades far beyond (up to K ~ 1e250, where the root is the scaled
+// asymptote with its first correction).  The support point takes this root without an
+// iteration, so it must be within a few ulps: the bound is 8 ulps of 1 (8 * 2^-53 = 8.9e-16),
+// the fit's error being ~1e-17 and the rest the rounding of 9 stored coefficients and of their
+// evaluation.
+TEST(Superquadric, FlatRootTableIsWithinAFewUlps) {
   auto root = [](int p, long double K) {
     long double lo = 0, hi = 1;  // (x down to ~2^-210: up to ~280 halvings)
     for (int it = 0; it < 2000; ++it) {
       const long double mid = 0.5L * (lo + hi);
       if (!(mid > lo && mid < hi)) break;
-      (std::pow(mid, p) + K * std::pow(mid, 2 * p - 2) - 1 > 0 ? hi : lo) = mid;
+      long double xp1 = 1;
+      for (int k = 0; k < p - 1; ++k) xp1 *= mid;
+      (xp1 * mid + K * xp1 * xp1 - 1 > 0 ? hi : lo) = mid;
     }
     return 0.5L * (lo + hi);
   };
@@ -338,25 +343,27 @@ TEST(Superquadric, FlatSolverStartIsWithin2e7OfTheRoot) {
   int worst_p = 0;
   for (int p = 3; p <= 16; ++p) {
     const Superquadric s{1.0, 0.7, 0.5, 2, 2, double(p)};
-    ASSERT_TRUE(s.has_flat_guess()) << p;
+    ASSERT_TRUE(s.has_flat_root_table()) << p;
     std::vector<int> binades;
     for (int E = 0; E < 64; ++E) binades.push_back(E);
     for (int E = 64; E < 830; E += 37) binades.push_back(E);
-    for (const int E : binades)
-      for (int j = 0; j < 8; ++j)
-        for (int i = 0; i <= 8; ++i) {
-          // 1 + K = 2^E (1 + (j + i/8) / 8), the last point just below the segment's end
-          const double m = (j + std::min(i / 8.0, 1.0 - 1e-12)) / 8.0;
+    for (const int E : binades) {
+      const int segs = E == 0 ? 32 : 16;
+      for (int j = 0; j < segs; ++j)
+        for (int i = 0; i <= 5; ++i) {
+          // 1 + K = 2^E (1 + (j + i/5) / segs), the last point just below the segment's end
+          const double m = (j + std::min(i / 5.0, 1.0 - 1e-12)) / segs;
           const double K = std::ldexp(1.0 + m, E) - 1.0;
           const long double x = root(p, K);
-          const double err = double(std::abs(s.flat_guess(K) - x) / x);
+          const double err = double(std::abs(s.flat_root(K) - x) / x);
           if (err > worst) worst = err, worst_p = p;
-          EXPECT_LE(err, 2e-7) << "p " << p << " E " << E << " j " << j << " i " << i;
+          EXPECT_LE(err, 8.9e-16) << "p " << p << " E " << E << " j " << j << " i " << i;
         }
+    }
   }
-  EXPECT_FALSE((Superquadric{1.0, 0.7, 0.5, 2, 2, 17}.has_flat_guess()));
-  EXPECT_FALSE((Superquadric{1.0, 0.7, 0.5, 2, 3, 8}.has_flat_guess()));
-  std::printf("  (2, 2, p) solver start: max relative error %.2e (p = %d)\n", worst, worst_p);
+  EXPECT_FALSE((Superquadric{1.0, 0.7, 0.5, 2, 2, 17}.has_flat_root_table()));
+  EXPECT_FALSE((Superquadric{1.0, 0.7, 0.5, 2, 3, 8}.has_flat_root_table()));
+  std::printf("  (2, 2, p) tabulated root: max relative error %.2e (p = %d)\n", worst, worst_p);
 }
 
 TEST(Superquadric, AllExponentsTwoIsTheEllipsoid) {
