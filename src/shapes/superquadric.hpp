@@ -133,6 +133,8 @@ struct FlatRootTable {
   double near[kNear][kCoef];
   double far[1 << kBits][kCoef];
   double scale[32];  // 2^(-r/(2p-2)), r < 2p - 2 <= 30
+  // The row of segment j of binade e < kBinades
+  static int segment(int e, int j) { return e == 0 ? j : (1 << kBits0) + ((e - 1) << kBits) + j; }
   static double estrin(const double* c, double u) {
     const double u2 = u * u, u4 = u2 * u2;
     const double a = (c[0] + c[1] * u) + u2 * (c[2] + c[3] * u);
@@ -149,7 +151,7 @@ struct FlatRootTable {
     const int j = static_cast<int>((bits & ((std::uint64_t{1} << 52) - 1)) >> shift);
     const double u = static_cast<double>(bits & ((std::uint64_t{1} << shift) - 1)) *
                      (first ? 0x1p-47 : 0x1p-48);
-    if (e < kBinades) return estrin(near[first ? j : (1 << kBits0) + ((e - 1) << kBits) + j], u);
+    if (e < kBinades) return estrin(near[segment(e, j)], u);
     // 2^-d from its bits (d <= 1024 / 4: a normal number), not std::ldexp: a call here would
     // make the callers' hot path save registers
     const int q = 2 * p - 2, d = e / q, r = e - d * q;
@@ -203,7 +205,7 @@ inline FlatRootTable make_flat_root_table(int p) {
     const int segs = 1 << (E == 0 ? FlatRootTable::kBits0 : FlatRootTable::kBits);
     for (int j = 0; j < segs; ++j) {
       for (int i = 0; i < n; ++i) v[i] = root(std::ldexp(1.0L + (j + u[i]) / segs, E) - 1.0L);
-      store(t.near[E == 0 ? j : (1 << FlatRootTable::kBits0) + ((E - 1) << FlatRootTable::kBits) + j], v);
+      store(t.near[FlatRootTable::segment(E, j)], v);
     }
   }
   constexpr int fsegs = 1 << FlatRootTable::kBits;
