@@ -177,7 +177,7 @@ inline LatticeCheck fit_particle_number(RigidPoint& pt) {
 // Counters of a simulation at one moment; differences give the cost of a stretch of events.
 struct Tally {
   double cpu = 0, wall = 0, collisions = 0, neighbour_events = 0, stale = 0;
-  double predictions = 0, distance_evals = 0, distance_nr = 0, axis_steps = 0, axis_bounds = 0, hits = 0,
+  double predictions = 0, distance_evals = 0, distance_nr = 0, contact_nr = 0, axis_steps = 0, axis_bounds = 0, hits = 0,
          hit_distance_evals = 0, grazing = 0, contact_fallbacks = 0, distance_fallbacks = 0,
          collision_distance_fallbacks = 0, prefiltered = 0, centre_line_clears = 0, collision_touches = 0,
          ordered_skips = 0;
@@ -186,7 +186,8 @@ struct Tally {
     d.cpu = cpu - o.cpu, d.wall = wall - o.wall, d.collisions = collisions - o.collisions;
     d.neighbour_events = neighbour_events - o.neighbour_events, d.stale = stale - o.stale;
     d.predictions = predictions - o.predictions, d.distance_evals = distance_evals - o.distance_evals;
-    d.distance_nr = distance_nr - o.distance_nr, d.axis_steps = axis_steps - o.axis_steps;
+    d.distance_nr = distance_nr - o.distance_nr, d.contact_nr = contact_nr - o.contact_nr;
+    d.axis_steps = axis_steps - o.axis_steps;
     d.axis_bounds = axis_bounds - o.axis_bounds;
     d.hits = hits - o.hits, d.hit_distance_evals = hit_distance_evals - o.hit_distance_evals;
     d.grazing = grazing - o.grazing, d.contact_fallbacks = contact_fallbacks - o.contact_fallbacks;
@@ -201,7 +202,7 @@ struct Tally {
   Tally& operator+=(const Tally& o) {
     cpu += o.cpu, wall += o.wall, collisions += o.collisions, neighbour_events += o.neighbour_events;
     stale += o.stale, predictions += o.predictions, distance_evals += o.distance_evals;
-    distance_nr += o.distance_nr, axis_steps += o.axis_steps, axis_bounds += o.axis_bounds, hits += o.hits;
+    distance_nr += o.distance_nr, contact_nr += o.contact_nr, axis_steps += o.axis_steps, axis_bounds += o.axis_bounds, hits += o.hits;
     hit_distance_evals += o.hit_distance_evals, grazing += o.grazing;
     contact_fallbacks += o.contact_fallbacks, distance_fallbacks += o.distance_fallbacks;
     collision_distance_fallbacks += o.collision_distance_fallbacks;
@@ -228,7 +229,8 @@ Tally tally(const Sim& sim) {
   if constexpr (requires { sim.model().stats; }) {
     const hb::SolverStats& s = sim.model().stats;
     t.predictions = double(s.predictions), t.distance_evals = double(s.distance_evals);
-    t.distance_nr = double(s.distance_nr_iterations), t.axis_steps = double(s.axis_steps);
+    t.distance_nr = double(s.distance_nr_iterations), t.contact_nr = double(s.contact_nr_iterations);
+    t.axis_steps = double(s.axis_steps);
     t.axis_bounds = double(s.axis_bounds);
     t.hits = double(s.hits), t.hit_distance_evals = double(s.hit_distance_evals);
     t.grazing = double(s.grazing_searches), t.contact_fallbacks = double(s.fallbacks);
@@ -292,6 +294,8 @@ inline void put_costs(Json& j, const Tally& d) {
   j["stale_per_collision"] = d.stale / nc;
   j["hits_per_collision"] = d.hits / nc;
   j["distance_evals_per_hit"] = d.hit_distance_evals / std::max(d.hits, 1.0);
+  // every contact-system Newton iteration (those of solves that find no contact too), per hit
+  j["contact_nr_iterations_per_hit"] = d.contact_nr / std::max(d.hits, 1.0);
   j["grazing_searches_per_collision"] = d.grazing / nc;
   j["fallbacks"] = d.fallbacks();
 }
