@@ -461,6 +461,30 @@ inline bool bounding_sphere_window(const BodyState& a, const BodyState& b, doubl
   return lo <= hi;
 }
 
+// The answer of bounding_sphere_window above (no growth) for the window [t_state, t_state + span]
+// without its roots: can spheres of radius sum R, centre separation p = r_B - r_A and relative
+// velocity dv at t_state (tau = 0) meet for some tau in [0, span] (span may be kInf)? With
+// P(tau) = A tau^2 + 2 Bh tau + C (A = |dv|^2, Bh = p.dv, C = |p|^2 - R^2), the set P <= 0 meets
+// [0, span] iff C <= 0 (they overlap now), or C > 0, Bh < 0 (they approach: the vertex
+// -Bh / A is ahead), Bh^2 >= A C (P has roots: the same test as the window's) and the
+// entry root t1 <= span, which fails iff P(span) > 0 with the vertex beyond span (P falls all
+// the way). No square root and no division: the prediction loop (system/rigid_bodies.hpp,
+// predict_contacts) runs it on every candidate and forms the window, with its roots, only for
+// the few that pass its axis test too. It agrees with the window up to rounding at the window's
+// edges (tau = span, or C = 0 while they recede; tests/contact/test_contact_time.cpp), where
+// the pair's bounding spheres, which carry the solver's margin, are apart at every time of the
+// window but one: the solver answers none there either.
+inline bool bounding_spheres_may_meet(const Vec3& p, const Vec3& dv, double R, double span) {
+  const double C = p.squaredNorm() - R * R;
+  if (C <= 0.0) return true;
+  const double Bh = p.dot(dv);
+  if (!(Bh < 0.0)) return false;
+  const double A = dv.squaredNorm();
+  if (Bh * Bh - A * C < 0.0) return false;
+  if (span < kInf && A * span + Bh < 0.0 && (A * span + 2.0 * Bh) * span + C > 0.0) return false;
+  return true;
+}
+
 // The start of the distance solve at a collision (bodies touching to within the solvers'
 // tolerance; orientations qa, qb, centre separation c = r_B - r_A): the support points of A
 // along the separating axis of separating_axis_at and of B along its opposite, as a guess

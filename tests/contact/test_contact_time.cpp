@@ -72,6 +72,71 @@ TEST(Contact, BoundingSphereWindowAndRate) {
   EXPECT_NEAR(distance_rate_bound(a, 2.0, b, 1.0), 1.0 + 6.0, 1e-15);
 }
 
+// bounding_spheres_may_meet (no roots) gives bounding_sphere_window's answer. Random pairs
+// (approaching, half of them aimed roughly at each other, receding, passing, overlapping now;
+// finite and infinite spans, a third with no relative velocity along one axis): the same answer every time. At the window's edges (the
+// span cut at the entry root to within a few ulps; spheres touching now and receding), where
+// rounding may decide either way, a "no" of the root-free test is checked in long double: the
+// spheres' smallest gap over the span is zero to rounding, 1e-13 R (nothing the solver, whose
+// radius carries its margin, could find).
+TEST(Contact, BoundingSpheresMayMeetIsTheWindowsAnswer) {
+  Rng r(77);
+  const BodyState a;
+  int meet = 0, apart = 0, differ = 0;
+  const int n = scaled_count(200000);
+  for (int k = 0; k < n; ++k) {
+    BodyState b;
+    const double R = r.uni(0.5, 3.0), span = k % 4 == 0 ? kInf : r.log_uni(1e-3, 10.0);
+    b.r = r.ball(3.0 * R);
+    b.v = r.ball(2.0);
+    if (k % 2 == 0) b.v += -r.uni(0.0, 2.0) * b.r.normalized();  // aimed at A, roughly
+    if (k % 3 == 1) b.v[k % 2] = 0.0;
+    double lo = 0.0, hi = span;
+    const bool win = bounding_sphere_window(a, b, 0.0, R, lo, hi) && lo <= hi;
+    const bool may = bounding_spheres_may_meet(b.r - a.r, b.v - a.v, R, span);
+    differ += win != may;
+    (win ? meet : apart) += 1;
+  }
+  std::printf("  random pairs: %d meet, %d apart, %d answers differ\n", meet, apart, differ);
+  EXPECT_EQ(differ, 0);
+  EXPECT_GT(meet, n / 20);
+  EXPECT_GT(apart, n / 20);
+
+  // the edges: the smallest gap |p + dv tau| - R over [0, span], in long double
+  auto min_gap = [](const Vec3& p, const Vec3& dv, double R, double span) {
+    long double A = 0, B = 0, C = 0;
+    for (int i = 0; i < 3; ++i) A += (long double)dv[i] * dv[i], B += (long double)p[i] * dv[i], C += (long double)p[i] * p[i];
+    long double tau = A > 0 ? -B / A : 0;
+    tau = std::clamp<long double>(tau, 0, span);
+    return std::sqrt(std::max<long double>(A * tau * tau + 2 * B * tau + C, 0)) - (long double)R;
+  };
+  int edges = 0, edge_no = 0;
+  double worst = 0.0;
+  for (int k = 0; k < scaled_count(20000); ++k) {
+    BodyState b;
+    b.r = r.ball(6.0);
+    b.v = r.ball(2.0);
+    const double R = r.uni(0.5, 3.0);
+    double span;
+    if (k % 2 == 0) {  // the span ends at the entry root, to a few ulps
+      double lo = 0.0, hi = kInf;
+      if (!bounding_sphere_window(a, b, 0.0, R, lo, hi) || !(lo > 0.0)) continue;
+      span = lo * (1.0 + (k % 7 - 3) * 2.2e-16);
+    } else {  // touching now and receding
+      b.r = R * (1.0 + (k % 5 - 2) * 2.2e-16) * r.unit();
+      b.v = r.uni(0.1, 2.0) * b.r.normalized() + r.ball(0.05);
+      span = r.uni(0.1, 5.0);
+    }
+    ++edges;
+    if (bounding_spheres_may_meet(b.r - a.r, b.v - a.v, R, span)) continue;
+    ++edge_no;
+    worst = std::min(worst, double(min_gap(b.r, b.v, R, span)) / R);
+  }
+  std::printf("  edges: %d cases, %d answered no; smallest gap of those %.2e R\n", edges, edge_no, worst);
+  EXPECT_GT(edge_no, edges / 10);
+  EXPECT_GT(worst, -1e-13);  // rounding, far below the solver's margin (>= 1e-9 L)
+}
+
 // The distance-rate bound K = |v_B - v_A| + |w_A| l_A + |w_B| l_B with the shapes' rotation
 // levers l (shapes/shape.hpp; l <= L, an ellipsoid's a_max - a_min) against central differences
 // of the distance of spinning ellipsoids (prolate, oblate, triaxial; spherical tops, so w is
