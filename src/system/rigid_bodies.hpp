@@ -266,10 +266,9 @@ double memo_or_centres_clear_time(const SA& A, const SB& B, const State& s, std:
 // "Session of 2026-12-06, fifth part"): the window's test took 8.5 % of the run's time
 // (a sampling profile), its square root and divisions formed for every candidate; root-free,
 // the run takes 0.95 of the time (alternating builds) for 1.7 % fewer instructions, the same
-// trajectory and counters. With a number (the
-// solver's own radius) the window found, {lo, hi}, is handed to solve as `window`, for
-// ContactInput::window_given (the solver does not repeat the test); else window is null (but
-// see `order` below).
+// trajectory and counters. With a number (the solver's own radius) the window found, {lo, hi},
+// is handed to solve as `window`, for ContactInput::window_given (the solver does not repeat
+// the test); else window is null (but see `order` below).
 //
 // `order` (with `trim`): the candidates left after both pre-filters are solved in the order of
 // their lower bounds of the contact time, t_lb = max(the bounding spheres' entry, now + the

@@ -74,11 +74,11 @@ TEST(Contact, BoundingSphereWindowAndRate) {
 
 // bounding_spheres_may_meet (no roots) gives bounding_sphere_window's answer. Random pairs
 // (approaching, half of them aimed roughly at each other, receding, passing, overlapping now;
-// finite and infinite spans, a third with no relative velocity along one axis): the same answer every time. At the window's edges (the
-// span cut at the entry root to within a few ulps; spheres touching now and receding), where
-// rounding may decide either way, a "no" of the root-free test is checked in long double: the
-// spheres' smallest gap over the span is zero to rounding, 1e-13 R (nothing the solver, whose
-// radius carries its margin, could find).
+// finite and infinite spans, a third with no relative velocity along one axis): the same
+// answer every time. At the window's edges (the span cut at the entry root to within a few
+// ulps; spheres touching now and receding), where rounding may decide either way, a "no" of the
+// root-free test is checked in long double: the spheres' smallest gap over the span is zero to
+// rounding, 1e-13 R (nothing the solver, whose radius carries its margin, could find).
 TEST(Contact, BoundingSpheresMayMeetIsTheWindowsAnswer) {
   Rng r(77);
   const BodyState a;
