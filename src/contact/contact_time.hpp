@@ -60,7 +60,11 @@
 //     Solver::certified_contact: the point on both surfaces, opposite normals, so by convexity
 //     the common tangent plane separates the bodies, and approaching); otherwise by a distance
 //     solve from the root's contact point (one NR iteration). A hit from the axis leaps then
-//     costs no distance solve at all. Otherwise the step is taken as above.
+//     costs no distance solve at all. The certificate is offered the root once before Newton
+//     converges, after its first full step below 1e-6 L (ContactOptions::certify_early), and
+//     takes it there only if its gap residual over the approach rate puts the time within the
+//     converged Newton's tolerance: a head-on entry needs one iteration instead of two, a
+//     grazing one iterates on. Otherwise the step is taken as above.
 //  Separating-axis advancement (beyond the paper; shapes with a support function; with growth
 //  the gap and its bounds carry the scale law, axis_gap.hpp).
 //  The gap g_n(t) along a fixed unit vector n (contact/axis_gap.hpp) is a lower bound of the
@@ -209,6 +213,11 @@ struct ContactOptions {
   // solve, the slow twin). Only acceptances are shortcut; what it cannot certify is checked by
   // the distance solve as before.
   bool certify_newton = true;
+  // The contact-system Newton offers its root to that certificate after its first full step
+  // below 1e-6 L (Solver::contact_newton), and stops there if the root is certified with a
+  // gap residual that, over the approach rate, is within the converged Newton's time
+  // tolerance 1e-12 L / K (false: Newton converges to that tolerance first, the slow twin).
+  bool certify_early = true;
   // At a collision of the rigid models, the contact read off the pair's memo axis when that is
   // the contact normal the prediction stored (touching_along, system/rigid_bodies.hpp: the
   // support points coincide to accept_tol) instead of a distance solve (false: the distance
@@ -751,26 +760,41 @@ struct Solver {
     out.normal = n;
   }
 
-  // Newton-Raphson on the contact system from y = (x, alpha, t); true if it converged with t
-  // inside [t_lo, t_hi] (a step that leaves it ends the iteration).
-  bool contact_newton(Vec5c& y, double t_lo, double t_hi) {
+  // How the contact-system Newton ended: no root in its interval, a converged root (still to
+  // be accepted, accept_newton), or a root certified and reported already (certify_early).
+  enum class NewtonEnd { failed, converged, certified };
+
+  // Newton-Raphson on the contact system from y = (x, alpha, t), time kept to [t_lo, t_hi] (a
+  // step that leaves it ends the iteration). It converges when a full step is below 1e-12 L
+  // in x and 1e-12 L / K in time. With ContactOptions::certify_newton and certify_early, the
+  // first full step below 1e-6 L (and 1e-6 L / K) offers its root once to certified_contact
+  // with the time criterion: Newton converges quadratically, so that root is usually within
+  // rounding of the converged one, and the certificate checks that it is (its gap residual
+  // over the approach rate within the time tolerance); `entering` is accept_newton's.
+  NewtonEnd contact_newton(Vec5c& y, double t_lo, double t_hi, bool entering) {
     const double dt_tol = 1e-12 * L / std::max(K, 1e-300);
+    bool offered = !(o.certify_newton && o.certify_early);
     for (int it = 0; it < o.max_nr_iter; ++it) {
       ++out.nr_iterations;
       Vec5c F;
       Mat5c J;
       contact_system(A, B, y, F, &J);
       Vec5c dy = SmallLU<5>(J).solve(-F);
-      if (!dy.allFinite()) return false;
+      if (!dy.allFinite()) return NewtonEnd::failed;
       const double dx = dy.head<3>().norm();
       double xi = 1.0;
       if (dx > 0.5 * L) xi = 0.5 * L / dx;
       if (std::abs(dy[3]) > 0.5 * std::abs(y[3])) xi = std::min(xi, 0.5 * std::abs(y[3] / dy[3]));
       y += xi * dy;
-      if (y[4] < t_lo - dt_tol || y[4] > t_hi + dt_tol) return false;  // left the interval
-      if (xi == 1.0 && dx <= 1e-12 * L && std::abs(dy[4]) <= dt_tol) return true;
+      if (y[4] < t_lo - dt_tol || y[4] > t_hi + dt_tol) return NewtonEnd::failed;  // left it
+      if (xi == 1.0 && dx <= 1e-12 * L && std::abs(dy[4]) <= dt_tol) return NewtonEnd::converged;
+      if (!offered && xi == 1.0 && dx <= 1e-6 * L && std::abs(dy[4]) <= 1e6 * dt_tol) {
+        offered = true;
+        if (certified_contact(y.head<3>(), std::clamp(y[4], t_lo, t_hi), entering, dt_tol))
+          return NewtonEnd::certified;
+      }
     }
-    return false;
+    return NewtonEnd::failed;
   }
 
   // The Newton result y (time in [t_lo, t_hi]) checked by a distance solve there: a contact if
@@ -810,7 +834,12 @@ struct Solver {
   // rate is within rounding of zero is left to the distance solve, so that the sign is decided
   // as before. Reports the hit (the same time, point and normal as the distance-solve path)
   // and returns true; false: not certified (nothing reported, nothing changed).
-  bool certified_contact(const Vec3& x, double tc, bool entering) {
+  // With time_tol > 0 (a Newton root before convergence, certify_early), the root's time must
+  // also be within time_tol of the converged one: the gap residual |f_A| / |grad f_A| +
+  // |f_B| / |grad f_B| + |n_A + n_B|^2 L over the approach rate |n_A . (u_B - u_A)| within
+  // time_tol. (Two surfaces through x whose normals misfit by e cross; for curved bodies the
+  // overlap is of order e^2 times their radii, so e^2 L bounds it at the bodies' size.)
+  bool certified_contact(const Vec3& x, double tc, bool entering, double time_tol = 0.0) {
     double fa, fb;
     Vec3 ga, gb, ua, ub;
     A.eval_first(x, tc, fa, ga, ua);
@@ -819,8 +848,13 @@ struct Solver {
     const double tol = o.accept_tol * L;
     if (!(na > 0.0 && nb > 0.0 && std::abs(fa) <= tol * na && std::abs(fb) <= tol * nb)) return false;
     const Vec3 n = ga / na;
-    if (!((n + gb / nb).norm() <= o.accept_tol)) return false;
-    if (entering && !(n.dot(ub - ua) < -o.accept_tol * K)) return false;
+    const double misfit = (n + gb / nb).norm();
+    if (!(misfit <= o.accept_tol)) return false;
+    const double rate = n.dot(ub - ua);
+    if (entering && !(rate < -o.accept_tol * K)) return false;
+    if (time_tol > 0.0 &&
+        !(std::abs(fa) / na + std::abs(fb) / nb + misfit * misfit * L <= time_tol * std::abs(rate)))
+      return false;
     report_hit(tc, x, ga.normalized());
     ++out.certified;
     return true;
@@ -843,8 +877,9 @@ struct Solver {
       Vec5c y;
       y << 0.5 * (pa.r + pa.R * ya + pb.r + pb.R * yb), std::sqrt(ga / gb),
           std::min(lo + axis_g / -axis_slope, t1);
-      if (!contact_newton(y, lo, t1)) return false;
-      if (!accept_newton(y, lo, t1, true)) return false;
+      const NewtonEnd e = contact_newton(y, lo, t1, true);
+      if (e == NewtonEnd::failed || (e == NewtonEnd::converged && !accept_newton(y, lo, t1, true)))
+        return false;
       ++out.ahead;
       return true;
     }
@@ -864,8 +899,9 @@ struct Solver {
     if (!(t0 <= t1)) return false;  // the rate does not reach contact within the step
     Vec5c y;
     y << 0.5 * (s.res.point_a + s.res.point_b), std::max(s.res.alpha, 1e-3), t0;
-    if (!contact_newton(y, s.t, t1)) return false;
-    if (!accept_newton(y, s.t, t1, true)) return false;
+    const NewtonEnd e = contact_newton(y, s.t, t1, true);
+    if (e == NewtonEnd::failed || (e == NewtonEnd::converged && !accept_newton(y, s.t, t1, true)))
+      return false;
     ++out.ahead;
     return true;
   }
@@ -878,7 +914,9 @@ struct Solver {
     const Sample& g = l.d <= -h.d ? l : h;
     Vec5c y;
     y << 0.5 * (g.res.point_a + g.res.point_b), std::max(g.res.alpha, 1e-3), t0;
-    if (contact_newton(y, l.t, h.t)) {
+    const NewtonEnd e = contact_newton(y, l.t, h.t, false);
+    if (e == NewtonEnd::certified) return;
+    if (e == NewtonEnd::converged) {
       if (accept_newton(y, l.t, h.t, false)) return;
       if (failed) return;
     }

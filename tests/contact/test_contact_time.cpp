@@ -459,12 +459,18 @@ TEST(Contact, NewtonAheadAgreesWithTheBracketedPath) {
 // grazing passes with and without rotation, just touching) and asymmetric tops, the same status,
 // and hits at the same time, point and normal bit for bit (the certificate only saves the
 // distance solve of an acceptance); the certificate is the usual path and saves solves.
+// The root offered to the certificate before Newton converges (certify_early, the default)
+// against the converged root: the same status, times within 2e-12 L / K of each other (each
+// is within the converged Newton's time tolerance, 1e-12 L / K, of the root), points and
+// normals to 1e-9, and fewer Newton iterations.
 TEST(Contact, CertifiedNewtonRootsAgreeWithTheDistanceSolve) {
   Rng r(51);
-  ContactOptions solve;
+  ContactOptions converged, solve;
+  converged.certify_early = false;
   solve.certify_newton = false;
   int hits = 0, certified = 0, n = 0;
-  long evals_on = 0, evals_off = 0;
+  long evals_on = 0, evals_off = 0, nr_early = 0, nr_converged = 0;
+  double worst_time = 0.0, worst_point = 0.0, worst_normal = 0.0;
   for (int kind = 0; kind <= 4; ++kind)
     for (int k = 0; k < scaled_count(600, 0.01, 4); ++k) {
       Scenario s = make_scenario(r, kind);
@@ -473,23 +479,41 @@ TEST(Contact, CertifiedNewtonRootsAgreeWithTheDistanceSolve) {
         s.sb.top = Vec3(r.uni(0.2, 1.0), r.uni(0.2, 1.0), r.uni(0.2, 1.0));
       }
       const ContactInput<Ellipsoid, Ellipsoid> in{s.a, s.b, s.sa, s.sb, 0.0, 0.0, s.t_max, 1e-5};
-      const ContactResult on = contact_time(in), ref = contact_time(in, solve);
+      const ContactResult early = contact_time(in), on = contact_time(in, converged),
+                          ref = contact_time(in, solve);
       ++n;
       EXPECT_EQ(ref.certified, 0);
       ASSERT_EQ(on.status, ref.status) << "kind " << kind << " k " << k;
+      ASSERT_EQ(early.status, on.status) << "kind " << kind << " k " << k;
       evals_on += on.distance_evals;
       evals_off += ref.distance_evals;
+      nr_early += early.nr_iterations;
+      nr_converged += on.nr_iterations;
       if (on.status != ContactStatus::hit) continue;
       ++hits;
       certified += on.certified;
       EXPECT_EQ(on.time, ref.time) << "kind " << kind << " k " << k;
       EXPECT_EQ(on.point, ref.point) << "kind " << kind << " k " << k;
       EXPECT_EQ(on.normal, ref.normal) << "kind " << kind << " k " << k;
+      const double L = std::max(s.a.bounding_radius(), s.b.bounding_radius());
+      const double K = (s.sb.v - s.sa.v).norm() + s.sa.w.norm() * s.a.bounding_radius() +
+                       s.sb.w.norm() * s.b.bounding_radius();
+      const double dt = std::abs(early.time - on.time) / (L / K);
+      worst_time = std::max(worst_time, dt);
+      worst_point = std::max(worst_point, (early.point - on.point).norm() / L);
+      worst_normal = std::max(worst_normal, (early.normal - on.normal).norm());
+      EXPECT_LE(dt, 2e-12) << "kind " << kind << " k " << k;
+      EXPECT_LE((early.point - on.point).norm(), 1e-9 * L) << "kind " << kind << " k " << k;
+      EXPECT_LE((early.normal - on.normal).norm(), 1e-9) << "kind " << kind << " k " << k;
     }
   std::printf("  %d pairs, %d hits, %d certified; distance evals %.2f -> %.2f per pair\n", n, hits,
               certified, double(evals_off) / n, double(evals_on) / n);
+  std::printf("  early certificate: Newton iterations %.2f -> %.2f per pair; largest differences "
+              "time %.2g L/K, point %.2g L, normal %.2g\n",
+              double(nr_converged) / n, double(nr_early) / n, worst_time, worst_point, worst_normal);
   EXPECT_GE(certified, hits / 2);  // the certificate is the usual path
   EXPECT_LT(evals_on, evals_off);
+  EXPECT_LT(nr_early, nr_converged);
 }
 
 // Just after a collision the pair touches (d ~ -1e-15) and separates: no spurious contact at

@@ -246,24 +246,43 @@ TEST(SuperquadricContact, AffineAxisStepsAgreeWithFirstOrderSteps) {
 // (exponents 4 to 20, tilts down to 0: flat faces meeting), and random flights of bars and slabs
 // (p = 4, 8, spherical and asymmetric tops). The same outcome, and hits at the same time, point
 // and normal bit for bit (the certificate only saves the distance solve of an acceptance).
+// The root offered to the certificate before Newton converges (certify_early, the default)
+// against the converged root: the same outcome, times within 2e-12 L / K of each other (each
+// is within the converged Newton's time tolerance, 1e-12 L / K, of the root), points and
+// normals to 1e-9, and fewer Newton iterations.
 TEST(SuperquadricContact, CertifiedNewtonRootsAgreeWithTheDistanceSolve) {
   Rng r(318);
-  ContactOptions solve;
+  ContactOptions converged, solve;
+  converged.certify_early = false;
   solve.certify_newton = false;
   Counts fast, slow;
   int certified = 0;
+  long nr_early = 0, nr_converged = 0;
+  double worst_time = 0.0;
   auto twin = [&](const Superquadric& a, const Superquadric& b, const BodyState& sa,
                   const BodyState& sb, double t_max, const std::string& what) {
     const ContactInput<Superquadric, Superquadric> in{a, b, sa, sb, 0.0, 0.0, t_max, 1e-5};
-    const ContactResult c = contact_time(in), c0 = contact_time(in, solve);
+    const ContactResult e = contact_time(in), c = contact_time(in, converged),
+                        c0 = contact_time(in, solve);
     fast.add(c), slow.add(c0);
     certified += c.certified;
+    nr_early += e.nr_iterations;
+    nr_converged += c.nr_iterations;
     EXPECT_EQ(c0.certified, 0);
     ASSERT_EQ(c.status, c0.status) << what;
+    ASSERT_EQ(e.status, c.status) << what;
     if (c.status != ContactStatus::hit) return;
     EXPECT_EQ(c.time, c0.time) << what;
     EXPECT_EQ(c.point, c0.point) << what;
     EXPECT_EQ(c.normal, c0.normal) << what;
+    const double L = std::max(a.bounding_radius(), b.bounding_radius());
+    const double K = (sb.v - sa.v).norm() + sa.w.norm() * a.bounding_radius() +
+                     sb.w.norm() * b.bounding_radius();
+    const double dt = std::abs(e.time - c.time) / (L / K);
+    worst_time = std::max(worst_time, dt);
+    EXPECT_LE(dt, 2e-12) << what;
+    EXPECT_LE((e.point - c.point).norm(), 1e-9 * L) << what;
+    EXPECT_LE((e.normal - c.normal).norm(), 1e-9) << what;
   };
   const int reps = scaled_count(4, 0.25, 1);
   for (double p : {4.0, 8.0, 12.0, 20.0})
@@ -295,10 +314,12 @@ TEST(SuperquadricContact, CertifiedNewtonRootsAgreeWithTheDistanceSolve) {
   }
   fast.print("certified");
   slow.print("distance solve");
-  std::printf("  %d roots certified\n", certified);
+  std::printf("  %d roots certified; early certificate: Newton iterations %ld -> %ld, largest "
+              "time difference %.2g L/K\n", certified, nr_converged, nr_early, worst_time);
   EXPECT_EQ(fast.failed + slow.failed, 0);
   EXPECT_GE(certified, fast.hits / 2);  // the usual path
   EXPECT_LT(fast.distance_evals, slow.distance_evals);
+  EXPECT_LT(nr_early, nr_converged);
 }
 
 // The leaving jump (ContactOptions::leave_jump) against its slow twin, distance samples: flat-

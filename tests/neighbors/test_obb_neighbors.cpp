@@ -232,6 +232,19 @@ EllipsoidNnlSim tweaked_nnl_simulation(const RigidSystemSpec& spec, Tweak&& twea
   return EllipsoidNnlSim(box, st, model, std::move(lists));
 }
 
+// The default NNL run of `seed` at phi = 0.45 (the fast path) against its slow twin, the model
+// changed by tweak(model): the same first 1000 collisions, then check(fast, slow, spec).
+template <class Tweak, class Check>
+void against_slow_twin(std::uint64_t seed, Tweak&& tweak, const char* what, Check&& check) {
+  RigidSystemSpec spec;
+  spec.seed = seed;
+  spec.phi = 0.45;
+  auto slow = tweaked_nnl_simulation(spec, tweak);
+  auto fast = make_ellipsoid_nnl_simulation(spec, 0.15);
+  expect_same_collisions(slow, fast, hb::testing::scaled_count(1000, 0.05), what);
+  check(fast, slow, spec);
+}
+
 // Two twin runs end with the same kinetic energy (to 1e-12 relative).
 template <class SimA, class SimB>
 void expect_same_energy(const SimA& a, const SimB& b) {
@@ -435,20 +448,18 @@ TEST(ObbNeighbors, PartnerLeftOutOfTheFirstPredictionGivesTheSameCollisions) {
 // one more pre-filter axis) against its slow twin, every search from its cold start: the same
 // collisions, fewer axis steps and more candidates ruled out before a solve, the same energy.
 TEST(ObbNeighbors, AxisMemoGivesTheSameCollisionsAsColdStarts) {
-  RigidSystemSpec spec;
-  spec.seed = 37;
-  spec.phi = 0.45;
-  auto cold = tweaked_nnl_simulation(spec, [](auto& m) { m.memo.on = false; });
-  auto fast = make_ellipsoid_nnl_simulation(spec, 0.15);
-  expect_same_collisions(cold, fast, hb::testing::scaled_count(1000, 0.05), "cold-started searches");
-  const SolverStats &f = fast.model().stats, &c = cold.model().stats;
-  std::printf("[ NNL ] axis steps %llu with the memo, %llu without; pre-filtered %llu and %llu\n",
-              (unsigned long long)f.axis_steps, (unsigned long long)c.axis_steps,
-              (unsigned long long)f.prefiltered, (unsigned long long)c.prefiltered);
-  EXPECT_LT(f.axis_steps, c.axis_steps);
-  EXPECT_GT(f.prefiltered, c.prefiltered);
-  EXPECT_EQ(f.fallbacks, 0u);
-  expect_same_energy(fast, cold);
+  against_slow_twin(
+      37, [](auto& m) { m.memo.on = false; }, "cold-started searches",
+      [](auto& fast, auto& cold, const RigidSystemSpec&) {
+        const SolverStats &f = fast.model().stats, &c = cold.model().stats;
+        std::printf("[ NNL ] axis steps %llu with the memo, %llu without; pre-filtered %llu and %llu\n",
+                    (unsigned long long)f.axis_steps, (unsigned long long)c.axis_steps,
+                    (unsigned long long)f.prefiltered, (unsigned long long)c.prefiltered);
+        EXPECT_LT(f.axis_steps, c.axis_steps);
+        EXPECT_GT(f.prefiltered, c.prefiltered);
+        EXPECT_EQ(f.fallbacks, 0u);
+        expect_same_energy(fast, cold);
+      });
 }
 
 // Every solve stores its axis on both sides (AxisMemo::store_both), so wherever both bodies'
@@ -508,13 +519,17 @@ TEST(ObbNeighbors, OrderedPredictionGivesTheSameCollisionsAsTheCandidatesOrder) 
 
 // Contact-time Newton roots certified without a distance solve (ContactOptions::certify_newton)
 // against the slow twin, a distance solve at every root: the same collisions, the same energy,
-// and the hits' distance solves gone.
+// and the hits' distance solves gone (both with converged Newton roots, certify_early off:
+// the certificate then changes no bit).
 TEST(ObbNeighbors, CertifiedNewtonRootsGiveTheSameCollisions) {
   RigidSystemSpec spec;
   spec.seed = 43;
   spec.phi = 0.45;
-  auto solve = tweaked_nnl_simulation(spec, [](auto& m) { m.options.certify_newton = false; });
-  auto fast = make_ellipsoid_nnl_simulation(spec, 0.15);
+  auto solve = tweaked_nnl_simulation(spec, [](auto& m) {
+    m.options.certify_newton = false;
+    m.options.certify_early = false;
+  });
+  auto fast = tweaked_nnl_simulation(spec, [](auto& m) { m.options.certify_early = false; });
   expect_same_collisions(solve, fast, hb::testing::scaled_count(1000, 0.05), "distance solves at the roots");
   const SolverStats &f = fast.model().stats, &c = solve.model().stats;
   std::printf("[ NNL ] distance solves in hits: %llu certified, %llu solved (%llu hits)\n",
@@ -525,25 +540,40 @@ TEST(ObbNeighbors, CertifiedNewtonRootsGiveTheSameCollisions) {
   expect_same_energy(fast, solve);
 }
 
+// Newton roots offered to the certificate after their first short step (ContactOptions::
+// certify_early) against the slow twin, roots converged first: the contact times agree to the
+// converged Newton's tolerance, not bit for bit, so the first 1000 collisions are the same to
+// 1e-9; fewer Newton iterations; a longer run has no overlap and conserves the energy.
+TEST(ObbNeighbors, EarlyCertificateGivesTheSameCollisions) {
+  against_slow_twin(
+      59, [](auto& m) { m.options.certify_early = false; }, "converged Newton roots",
+      [](auto& fast, auto& converged, const RigidSystemSpec& spec) {
+        const SolverStats &f = fast.model().stats, &c = converged.model().stats;
+        std::printf("[ NNL ] contact Newton iterations: %llu certified early, %llu converged\n",
+                    (unsigned long long)f.contact_nr_iterations,
+                    (unsigned long long)c.contact_nr_iterations);
+        EXPECT_LT(f.contact_nr_iterations, c.contact_nr_iterations);
+        expect_overlap_free_and_conservative(fast, spec);
+      });
+}
+
 // Collisions whose contact is read off the pair's memo axis (ContactOptions::touch_from_memo,
 // touching_along) against the slow twin, a distance solve at every collision: the contacts
 // agree to the solvers' tolerance, not bit for bit, so the runs would part after a while (the
 // fluid is chaotic); the first 1000 collisions are the same to 1e-9, most contacts are read off
 // the axis, and a longer run has no overlap and conserves the energy.
 TEST(ObbNeighbors, ContactsReadOffTheMemoAxisGiveTheSameCollisions) {
-  RigidSystemSpec spec;
-  spec.seed = 47;
-  spec.phi = 0.45;
-  auto solve = tweaked_nnl_simulation(spec, [](auto& m) { m.options.touch_from_memo = false; });
-  auto fast = make_ellipsoid_nnl_simulation(spec, 0.15);
-  expect_same_collisions(solve, fast, hb::testing::scaled_count(1000, 0.05), "distance solves at the collisions");
-  const std::uint64_t touches = fast.model().stats.collision_touches;
-  std::printf("[ NNL ] contacts read off the memo axis: %llu of %llu collisions (slow twin %llu)\n",
-              (unsigned long long)touches, (unsigned long long)fast.collisions(),
-              (unsigned long long)solve.model().stats.collision_touches);
-  EXPECT_EQ(solve.model().stats.collision_touches, 0u);
-  EXPECT_GT(touches, fast.collisions() * 9 / 10);
-  expect_overlap_free_and_conservative(fast, spec);
+  against_slow_twin(
+      47, [](auto& m) { m.options.touch_from_memo = false; }, "distance solves at the collisions",
+      [](auto& fast, auto& solve, const RigidSystemSpec& spec) {
+        const std::uint64_t touches = fast.model().stats.collision_touches;
+        std::printf("[ NNL ] contacts read off the memo axis: %llu of %llu collisions (slow twin %llu)\n",
+                    (unsigned long long)touches, (unsigned long long)fast.collisions(),
+                    (unsigned long long)solve.model().stats.collision_touches);
+        EXPECT_EQ(solve.model().stats.collision_touches, 0u);
+        EXPECT_GT(touches, fast.collisions() * 9 / 10);
+        expect_overlap_free_and_conservative(fast, spec);
+      });
 }
 
 // The rate bounds of bodies of revolution from the spin across their axes (shapes/shape.hpp
