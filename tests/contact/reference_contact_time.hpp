@@ -133,4 +133,14 @@ RefContact reference_contact_time(const SA& a, const BodyState& sa, const SB& b,
   return out;
 }
 
+// The time unit L / K of a pair: L the larger bounding radius, K = |v_B - v_A| + |w_A| L_A +
+// |w_B| L_B with the states' angular velocities (the header's K, which for tops that are not
+// spherical takes their largest |w|). Twin tests give contact-time differences in it.
+template <SupportShape SA, SupportShape SB>
+double time_unit(const SA& a, const SB& b, const BodyState& sa, const BodyState& sb) {
+  const double K = (sb.v - sa.v).norm() + sa.w.norm() * a.bounding_radius() +
+                   sb.w.norm() * b.bounding_radius();
+  return std::max(a.bounding_radius(), b.bounding_radius()) / K;
+}
+
 }  // namespace hb::ref

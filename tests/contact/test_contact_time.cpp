@@ -496,9 +496,7 @@ TEST(Contact, CertifiedNewtonRootsAgreeWithTheDistanceSolve) {
       EXPECT_EQ(on.point, ref.point) << "kind " << kind << " k " << k;
       EXPECT_EQ(on.normal, ref.normal) << "kind " << kind << " k " << k;
       const double L = std::max(s.a.bounding_radius(), s.b.bounding_radius());
-      const double K = (s.sb.v - s.sa.v).norm() + s.sa.w.norm() * s.a.bounding_radius() +
-                       s.sb.w.norm() * s.b.bounding_radius();
-      const double dt = std::abs(early.time - on.time) / (L / K);
+      const double dt = std::abs(early.time - on.time) / ref::time_unit(s.a, s.b, s.sa, s.sb);
       worst_time = std::max(worst_time, dt);
       worst_point = std::max(worst_point, (early.point - on.point).norm() / L);
       worst_normal = std::max(worst_normal, (early.normal - on.normal).norm());

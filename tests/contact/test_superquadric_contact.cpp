@@ -276,9 +276,7 @@ TEST(SuperquadricContact, CertifiedNewtonRootsAgreeWithTheDistanceSolve) {
     EXPECT_EQ(c.point, c0.point) << what;
     EXPECT_EQ(c.normal, c0.normal) << what;
     const double L = std::max(a.bounding_radius(), b.bounding_radius());
-    const double K = (sb.v - sa.v).norm() + sa.w.norm() * a.bounding_radius() +
-                     sb.w.norm() * b.bounding_radius();
-    const double dt = std::abs(e.time - c.time) / (L / K);
+    const double dt = std::abs(e.time - c.time) / ref::time_unit(a, b, sa, sb);
     worst_time = std::max(worst_time, dt);
     EXPECT_LE(dt, 2e-12) << what;
     EXPECT_LE((e.point - c.point).norm(), 1e-9 * L) << what;
