@@ -246,6 +246,19 @@ void tally_touching_pairs(testing::Rng& r, const Apart& apart, Tally& t) {
   }
 }
 
+// Both sets at once: the random needles (with their counts) and the touching pairs.
+struct PairTallies {
+  Tally random, touching;
+  long random_decided = 0, random_disjoint = 0;
+};
+template <class Apart>
+PairTallies tally_pairs(testing::Rng& r, const Apart& apart) {
+  PairTallies p;
+  tally_random_pairs(r, apart, p.random, p.random_decided, p.random_disjoint);
+  tally_touching_pairs(r, apart, p.touching);
+  return p;
+}
+
 // The checks and the printed counts of the capsule tests below: no overlapping pair ruled out in
 // any set, all of the disjoint corner pairs and none of the overlapping ones ruled out, and at
 // least 1 / `share` of the random disjoint pairs ruled out (not a vacuous test).
@@ -358,10 +371,7 @@ TEST(Obb, CapsuleBallTestRulesOutOnlyDisjointBoxes) {
   auto apart = [](const Obb& a, const Obb& b) {
     return obb_capsule_ball_apart(a, obb_core(a.half), b.circumradius(), Vec3(b.centre - a.centre));
   };
-  Tally random, touching;
-  long random_decided = 0, random_disjoint = 0;
-  tally_random_pairs(r, apart, random, random_decided, random_disjoint);
-  tally_touching_pairs(r, apart, touching);
+  const auto [random, touching, random_decided, random_disjoint] = tally_pairs(r, apart);
   // a's corner c = centre + h0 u0 + rho_a n (n = (h1 u1 + h2 u2) / rho_a, normal to u0) is
   // rho_a from the segment's end; b turned so that its corner offset b.axes b.half is -rb n, its
   // centre at c + (gap + rb) n: the centre is rho_a + rb + gap from a's segment, and the plane
@@ -386,6 +396,86 @@ TEST(Obb, CapsuleBallTestRulesOutOnlyDisjointBoxes) {
   }
   check_apart_tallies("capsule-ball", {{"random needles", random}, {"touching", touching}}, corner_pairs,
                       corner_apart_disjoint, corner_apart_overlapping, random_decided, random_disjoint, 4);
+}
+
+// obb_inner_capsules_meet (the neighbour-list rebuilds' test ahead of obb_overlap: true proves the
+// boxes overlap) against the edge-clipping brute force. Each box holds the capsule around its
+// inner segment (long half-extent h less the thinner of the other two, m) of radius m: checked on
+// random points of those capsules. Random needles (it may call no disjoint pair overlapping, and
+// must decide a fair share of the overlapping ones), pairs 1e-7 from touching (boxes), and the
+// adversarial pairs whose inner capsules touch: a's segment end e_a, b's segment end at
+// e_a + (m_a + m_b + gap) n with n normal to both axes, so the segments are m_a + m_b + gap apart
+// (e_a and e_b are their closest points): at gap = -1e-6 of the size the test must find the
+// overlap, at +1e-6 it must not claim one (its slack is ~1e-9 of the scale).
+TEST(Obb, InnerCapsuleTestFindsOnlyOverlappingBoxes) {
+  testing::Rng r(20261207);
+  auto meet = [](const Obb& a, const Obb& b) {
+    return obb_inner_capsules_meet(a, obb_core(a.half), b, obb_core(b.half), Vec3(b.centre - a.centre));
+  };
+  // containment: points of the inner capsule lie in the box
+  double worst = -kInf;
+  for (int k = 0; k < hb::testing::scaled_count(2000, 0.1); ++k) {
+    const Obb b = random_box(r, 20.0);
+    const ObbCore c = obb_core(b.half);
+    for (int m = 0; m < 8; ++m) {
+      const Vec3 x = r.uni(-1.0, 1.0) * (c.half - c.thin) * b.axes.col(c.axis) + c.thin * r.uni(0.0, 1.0) * r.unit();
+      worst = std::max(worst, ((b.axes.transpose() * x).cwiseAbs() - b.half).maxCoeff());
+    }
+  }
+  EXPECT_LE(worst, 1e-12);
+  // the random and touching pairs of the capsule tests, with "not meeting" as the test that
+  // rules pairs out: a pair it keeps is one it calls overlapping (Tally: false_overlap is then
+  // the error, overlap - false_disjoint the overlapping pairs found)
+  auto apart = [&](const Obb& a, const Obb& b) { return !meet(a, b); };
+  const PairTallies tallies = tally_pairs(r, apart);
+  const Tally &random = tallies.random, &touching = tallies.touching;
+  long edge_pairs = 0, found_when_meeting = 0, claimed_when_apart = 0;
+  for (int k = 0; k < hb::testing::scaled_count(4000, 0.05); ++k) {
+    Obb a = random_box(r, 20.0), b = random_box(r, 20.0);
+    const ObbCore ca = obb_core(a.half), cb = obb_core(b.half);
+    const Vec3 u = a.axes.col(ca.axis);
+    Vec3 n = r.unit();
+    n = (n - n.dot(u) * u).normalized();
+    Vec3 v;  // b's axis normal to n: at random, or within 1e-12 .. 1e-2 rad of u
+    if (k % 4) {
+      v = r.unit();
+      v = (v - v.dot(n) * n).normalized();
+    } else {
+      const double e = r.log_uni(1e-12, 1e-2);
+      v = std::cos(e) * u + std::sin(e) * n.cross(u);
+    }
+    // b's axes: the long one along v, the others turned at random about it
+    const Mat3 turn = Eigen::AngleAxisd(r.uni(0.0, 6.283185307179586), v).toRotationMatrix();
+    const Vec3 p = v.unitOrthogonal();
+    Mat3 axes;
+    axes.col(cb.axis) = v;
+    axes.col((cb.axis + 1) % 3) = turn * p;
+    axes.col((cb.axis + 2) % 3) = turn * v.cross(p);
+    b.axes = axes;
+    const Vec3 ea = a.centre + (ca.half - ca.thin) * u;
+    for (double sgn : {-1.0, 1.0}) {
+      const double gap = sgn * 1e-6 * (a.half.norm() + b.half.norm());
+      // b's segment end -(h - m) v sits at ea + (m_a + m_b + gap) n
+      b.centre = ea + (ca.thin + cb.thin + gap) * n + (cb.half - cb.thin) * v;
+      ++edge_pairs;
+      if (sgn < 0.0) {
+        found_when_meeting += meet(a, b);
+        ASSERT_TRUE(brute_overlap(a, b, Vec3::Zero())) << k;  // the construction itself
+      } else {
+        claimed_when_apart += meet(a, b);
+      }
+    }
+  }
+  std::printf("[ inner ] random needles: %ld of %ld overlapping found, %ld claimed wrongly; touching "
+              "boxes: %ld pairs, %ld claimed wrongly; inner capsules 1e-6 from touching: %ld pairs, "
+              "%ld of the meeting found, %ld of the apart claimed\n",
+              random.overlap - random.false_disjoint, random.overlap, random.false_overlap,
+              touching.pairs, touching.false_overlap, edge_pairs, found_when_meeting, claimed_when_apart);
+  EXPECT_EQ(random.false_overlap, 0);
+  EXPECT_EQ(touching.false_overlap, 0);
+  EXPECT_EQ(found_when_meeting, edge_pairs / 2);
+  EXPECT_EQ(claimed_when_apart, 0);
+  EXPECT_GT(random.overlap - random.false_disjoint, random.overlap / 4);  // not a vacuous test
 }
 
 }  // namespace

@@ -128,7 +128,7 @@ void random_rebuilds_keep_lists_equal_to_brute_force(const Vec3& L) {
     EXPECT_TRUE(std::is_sorted(a.begin(), a.end()));
     EXPECT_EQ(std::adjacent_find(a.begin(), a.end()), a.end());  // no body twice
   }
-  // the twins (one pre-test off each) rebuild from the snapshot: lists that differ
+  // the twins (pre-tests off) rebuild from the snapshot: lists that differ
   auto differing = [&](const ObbNeighbors<Ellipsoid>& twin) {
     long differ = 0;
     for (std::uint32_t i = 0; i < n; ++i)
@@ -136,7 +136,7 @@ void random_rebuilds_keep_lists_equal_to_brute_force(const Vec3& L) {
                             twin.lists().end(i));
     return differ;
   };
-  ObbNeighbors<Ellipsoid> twin(e, 0.2);  // the capsule test off: every pair to the SAT
+  ObbNeighbors<Ellipsoid> twin(e, 0.2);  // the capsule tests off: every pair to the SAT
   twin.set_capsule_test(false);
   twin.restore(box, s, nb.snapshot());
   EXPECT_EQ(differing(twin), 0);
@@ -144,6 +144,11 @@ void random_rebuilds_keep_lists_equal_to_brute_force(const Vec3& L) {
   plain.set_box_test(false);
   plain.restore(box, s, nb.snapshot());
   EXPECT_EQ(differing(plain), 0);
+  ObbNeighbors<Ellipsoid> outer(e, 0.2);  // the inner capsule test off: the outer ones and the SAT
+  outer.set_inner_test(false);
+  EXPECT_TRUE(nb.inner_test());  // on by default
+  outer.restore(box, s, nb.snapshot());
+  EXPECT_EQ(differing(outer), 0);
 }
 
 TEST(ObbNeighbors, RandomRebuildsKeepListsEqualToBruteForce) {
