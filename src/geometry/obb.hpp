@@ -124,6 +124,22 @@ inline ObbCore obb_core(const Vec3& half) {
   return (d - s * u).squaredNorm() > reach * reach + 2e-9 * (ca.half * ca.half + d.squaredNorm());
 }
 
+// A point pair of the segments s u (|s| <= hp) and d + t v (|t| <= hq) near their closest pair:
+// Ericson's clamped alternation (as closest_segment_points, geometry/segment.hpp), exact for
+// segments that are not parallel; for (nearly) parallel ones a pair near the valley's bottom.
+// The capsule tests below bound the segments' distance from it, each in its own direction.
+struct SegmentPair {
+  double s, t;
+};
+inline SegmentPair segment_pair(const Vec3& u, double hp, const Vec3& v, double hq, const Vec3& d) {
+  const double uv = u.dot(v), den = 1.0 - uv * uv;
+  const double du = -u.dot(d), dv = -v.dot(d);  // w = P(0) - Q(0) = -d: u.w, v.w
+  double s = den > 1e-12 ? std::clamp((uv * dv - du) / den, -hp, hp) : 0.0;
+  const double t = std::clamp(dv + uv * s, -hq, hq);
+  s = std::clamp(uv * t - du, -hp, hp);
+  return {s, t};
+}
+
 // A cheaper test ahead of obb_overlap for elongated boxes: true only when the boxes are proven
 // disjoint (false: not decided here). Box a lies inside the capsule around the central segment of
 // its long axis (core ca: half-length ca.half) of radius ca.rho: a point c + s u_k + y u_i + z u_j
@@ -136,20 +152,16 @@ inline ObbCore obb_core(const Vec3& half) {
 // tangent plane: F(x) >= F(x0) + grad F(x0).(x - x0), whose minimum over the rectangle is
 // F(x0) + sum_k min(g_k (lo_k - x0_k), g_k (hi_k - x0_k)) (g = grad F: 2 u.r, -2 v.r with
 // r = s u - t v - d). At the minimiser the sum is 0 (the optimality conditions); x0 comes from
-// Ericson's clamped alternation (as closest_segment_points, geometry/segment.hpp), exact for
-// segments that are not parallel and near the valley's bottom for (nearly) parallel ones, where
-// its unconstrained step loses digits (then the sum is the small price). So the bound holds
+// segment_pair above, exact for segments that are not parallel and near the valley's bottom
+// for (nearly) parallel ones, where its unconstrained step loses digits (then the sum is the
+// small price). So the bound holds
 // however x0 was found, up to the rounding of F and g (~1e-14 S^2, S = h_a + h_b + |d|); the
 // test asks for 2e-9 ((h_a + h_b)^2 + |d|^2) beyond (rho_a + rho_b)^2.
 inline bool obb_capsules_apart(const Obb& a, const ObbCore& ca, const Obb& b, const ObbCore& cb,
                                const Vec3& d) {
   const Vec3 u = a.axes.col(ca.axis), v = b.axes.col(cb.axis);
   const double hp = ca.half, hq = cb.half;
-  const double uv = u.dot(v), den = 1.0 - uv * uv;
-  const double du = -u.dot(d), dv = -v.dot(d);  // w = P(0) - Q(0) = -d: u.w, v.w
-  double s = den > 1e-12 ? std::clamp((uv * dv - du) / den, -hp, hp) : 0.0;
-  const double t = std::clamp(dv + uv * s, -hq, hq);
-  s = std::clamp(uv * t - du, -hp, hp);
+  const auto [s, t] = segment_pair(u, hp, v, hq, d);
   const Vec3 r = s * u - t * v - d;
   const double gs = 2.0 * u.dot(r), gt = -2.0 * v.dot(r);
   const double lower = r.squaredNorm() + std::min(gs * (-hp - s), gs * (hp - s)) +
@@ -158,14 +170,13 @@ inline bool obb_capsules_apart(const Obb& a, const ObbCore& ca, const Obb& b, co
   return lower > reach * reach + 2e-9 * (h * h + d.squaredNorm());
 }
 
-// The converse test, ahead of obb_overlap for every box: true only when the boxes are proven to
-// overlap (false: not decided here). Box a holds the capsule around the inner segment of its long
+// The converse test, ahead of obb_overlap (the neighbour lists run it on elongated boxes, ahead
+// of the two above): true only when the boxes are proven to overlap (false: not decided here). Box a holds the capsule around the inner segment of its long
 // axis, c +- (h_k - m) u_k, of radius m = ca.thin (the smaller of the other two half-extents): a
 // point s u_k + x with |s| <= h_k - m and |x| <= m has |coordinate| <= |s| + m <= h_k along u_k
 // and <= m along the other two axes. So capsules that meet hold boxes that meet. Any point pair
 // (s, t) of the two segments bounds their distance from above: |s u - t v - d|; the pair comes
-// from the same clamped alternation as obb_capsules_apart (exact for segments that are not
-// parallel; for parallel ones a pair of points, whose distance only bounds from above). The
+// from segment_pair, as obb_capsules_apart's. The
 // test asks for 2e-9 ((h_a + h_b)^2 + |d|^2) below (m_a + m_b)^2 against rounding. About 30
 // instructions against ~500 for the full 15-axis test on overlapping boxes (every axis tried).
 // Boxes that are not elongated have segments of length ~0: the test is then that of the
@@ -174,11 +185,7 @@ inline bool obb_inner_capsules_meet(const Obb& a, const ObbCore& ca, const Obb& 
                                     const Vec3& d) {
   const Vec3 u = a.axes.col(ca.axis), v = b.axes.col(cb.axis);
   const double hp = ca.half - ca.thin, hq = cb.half - cb.thin;
-  const double uv = u.dot(v), den = 1.0 - uv * uv;
-  const double du = -u.dot(d), dv = -v.dot(d);
-  double s = den > 1e-12 ? std::clamp((uv * dv - du) / den, -hp, hp) : 0.0;
-  const double t = std::clamp(dv + uv * s, -hq, hq);
-  s = std::clamp(uv * t - du, -hp, hp);
+  const auto [s, t] = segment_pair(u, hp, v, hq, d);
   const double reach = ca.thin + cb.thin, h = hp + hq;
   return (s * u - t * v - d).squaredNorm() < reach * reach - 2e-9 * (h * h + d.squaredNorm());
 }
