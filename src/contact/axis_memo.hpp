@@ -57,6 +57,18 @@ class AxisMemo {
     n = -n;
     return true;
   }
+  // For the pre-filter of every candidate (system/rigid_bodies.hpp, memo_or_centres_clear_time):
+  // find_either while the memo holds at most kPartnerSideBodies bodies (2 MB, within a core's
+  // cache), else i's own slot alone. In a large system the partner's slot is a cache miss that
+  // the prediction waits on, for every candidate whose own slot misses (most are pairs never
+  // solved, in neither memo); the few axes it finds (its own slot lost to another partner) save
+  // less than the wait. Measured (docs/benchmarks/README.md, "Session of 2026-12-07, second
+  // part"), own slot alone against either, ellipsoids X0 = 2 at phi = 0.5, alternating runs:
+  // N = 256 +1.7 % (instructions +1.9 %), 4096 -2.8 %, 32000 -9.4 %, 256000 -11.8 %.
+  static constexpr std::size_t kPartnerSideBodies = 2048;
+  bool find_near(std::uint32_t i, std::uint32_t j, Vec3& n) const {
+    return slots_.size() <= kPartnerSideBodies * kSlots ? find_either(i, j, n) : find(i, j, n);
+  }
   // Axis n of a solve or the contact normal of a collision of i and j (from i to j), for both
   // sides (see the header).
   void store_both(std::size_t n_bodies, std::uint32_t i, std::uint32_t j, const Vec3& n) {

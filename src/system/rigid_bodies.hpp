@@ -205,8 +205,9 @@ inline SpinBound spin_bound(const State& s, std::uint32_t j) {
 // A, state a at `now`) and candidate j (shape B, centre separation c at `now`, orientation at its
 // own time) are proven not to touch, a duration from `now`, by the gap along one fixed axis
 // (axis_clear_time, to first and second order; any fixed axis gives a valid bound): the pair's
-// last separating axis in the memo, either side's slot (AxisMemo::find_either, as the solver's
-// axis_start), or, for a pair not in the memo, their line of centres (centres_clear_time).
+// last separating axis in the memo, either side's slot (AxisMemo::find_near: the partner's only
+// while the memo is small enough to stay in the cache), or, for a pair not found there, their
+// line of centres (centres_clear_time).
 // Measured (callgrind, docs/benchmarks/README.md, "Session of 2026-11-29, eighth part"):
 // - the second order along the memo's axis clears half the candidates the first order leaves
 //   to the solver at X0 = 10, phi = 0.4 (-9.4 % instructions there, -4.6 % at X0 = 2, phi = 0.5);
@@ -236,7 +237,7 @@ double memo_or_centres_clear_time(const SA& A, const SB& B, const State& s, std:
   }
   const double age = now - s.t[j], span = horizon - now;
   Vec3 u;
-  if (memo.find_either(i, j, u))
+  if (memo.find_near(i, j, u))
     return axis_clear_time(A, fa, a.w, B, s.q[j], s.w[j], c, near_unit_normalized(u), dv, age, span,
                            wa, wb, /*second_order=*/true);
   return centres_clear_time(A, fa, a.w, B, s.q[j], s.w[j], c, dv, age, span, wa, wb,

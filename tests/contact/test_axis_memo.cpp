@@ -36,6 +36,25 @@ TEST(AxisMemo, StoresFindsAndMisses) {
   EXPECT_FALSE(off.find(1, 1, n));  // nothing was stored while off
 }
 
+// find_near: either side's slot in a memo of at most kPartnerSideBodies bodies, the own slot
+// alone in a larger one (its partner's slots would be a cache miss).
+TEST(AxisMemo, FindNearLooksAtThePartnerOnlyInASmallMemo) {
+  const Vec3 u = Vec3(0.3, -0.4, 0.5).normalized();
+  for (const std::size_t bodies : {std::size_t(10), AxisMemo::kPartnerSideBodies,
+                                   AxisMemo::kPartnerSideBodies + 1}) {
+    AxisMemo m;
+    m.store(bodies, 2, 5, u);  // only 2's slot for 5
+    Vec3 n;
+    ASSERT_TRUE(m.find_near(2, 5, n));
+    EXPECT_EQ(n, u);
+    ASSERT_TRUE(m.find_either(5, 2, n));  // from the other side, negated
+    EXPECT_EQ(n, Vec3(-u));
+    const bool small = bodies <= AxisMemo::kPartnerSideBodies;
+    EXPECT_EQ(m.find_near(5, 2, n), small) << bodies << " bodies";
+    EXPECT_FALSE(m.find_near(5, 3, n));
+  }
+}
+
 TEST(AxisMemo, RowsRestoreTheSameMemo) {
   std::mt19937_64 g(5);
   std::normal_distribution<double> z(0.0, 1.0);
