@@ -65,9 +65,13 @@ class AxisMemo {
   // less than the wait. Measured (docs/benchmarks/README.md, "Session of 2026-12-07, second
   // part"), own slot alone against either, ellipsoids X0 = 2 at phi = 0.5, alternating runs:
   // N = 256 +1.7 % (instructions +1.9 %), 4096 -2.8 %, 32000 -9.4 %, 256000 -11.8 %.
+  // (The size is compared only after the own slot missed: e1 asks ~34 times a collision.)
   static constexpr std::size_t kPartnerSideBodies = 2048;
   bool find_near(std::uint32_t i, std::uint32_t j, Vec3& n) const {
-    return slots_.size() <= kPartnerSideBodies * kSlots ? find_either(i, j, n) : find(i, j, n);
+    if (find(i, j, n)) return true;
+    if (slots_.size() > kPartnerSideBodies * kSlots || !find(j, i, n)) return false;
+    n = -n;
+    return true;
   }
   // Axis n of a solve or the contact normal of a collision of i and j (from i to j), for both
   // sides (see the header).
