@@ -154,9 +154,9 @@ inline SegmentPair segment_pair(const Vec3& u, double hp, const Vec3& v, double 
 // r = s u - t v - d). At the minimiser the sum is 0 (the optimality conditions); x0 comes from
 // segment_pair above, exact for segments that are not parallel and near the valley's bottom
 // for (nearly) parallel ones, where its unconstrained step loses digits (then the sum is the
-// small price). So the bound holds
-// however x0 was found, up to the rounding of F and g (~1e-14 S^2, S = h_a + h_b + |d|); the
-// test asks for 2e-9 ((h_a + h_b)^2 + |d|^2) beyond (rho_a + rho_b)^2.
+// small price). So the bound holds however x0 was found, up to the rounding of F and g
+// (~1e-14 S^2, S = h_a + h_b + |d|); the test asks for 2e-9 ((h_a + h_b)^2 + |d|^2) beyond
+// (rho_a + rho_b)^2.
 inline bool obb_capsules_apart(const Obb& a, const ObbCore& ca, const Obb& b, const ObbCore& cb,
                                const Vec3& d) {
   const Vec3 u = a.axes.col(ca.axis), v = b.axes.col(cb.axis);
@@ -171,16 +171,16 @@ inline bool obb_capsules_apart(const Obb& a, const ObbCore& ca, const Obb& b, co
 }
 
 // The converse test, ahead of obb_overlap (the neighbour lists run it on elongated boxes, ahead
-// of the two above): true only when the boxes are proven to overlap (false: not decided here). Box a holds the capsule around the inner segment of its long
-// axis, c +- (h_k - m) u_k, of radius m = ca.thin (the smaller of the other two half-extents): a
-// point s u_k + x with |s| <= h_k - m and |x| <= m has |coordinate| <= |s| + m <= h_k along u_k
-// and <= m along the other two axes. So capsules that meet hold boxes that meet. Any point pair
-// (s, t) of the two segments bounds their distance from above: |s u - t v - d|; the pair comes
-// from segment_pair, as obb_capsules_apart's. The
-// test asks for 2e-9 ((h_a + h_b)^2 + |d|^2) below (m_a + m_b)^2 against rounding. About 30
-// instructions against ~500 for the full 15-axis test on overlapping boxes (every axis tried).
-// Boxes that are not elongated have segments of length ~0: the test is then that of the
-// inscribed spheres. d: b's centre (at its image) minus a's.
+// of the two above): true only when the boxes are proven to overlap (false: not decided here).
+// Box a holds the capsule around the inner segment of its long axis, c +- (h_k - m) u_k, of
+// radius m = ca.thin (the smaller of the other two half-extents): a point s u_k + x with
+// |s| <= h_k - m and |x| <= m has |coordinate| <= |s| + m <= h_k along u_k and <= m along the
+// other two axes. So capsules that meet hold boxes that meet. Any point pair (s, t) of the two
+// segments bounds their distance from above: |s u - t v - d|; the pair comes from segment_pair,
+// as obb_capsules_apart's. The test asks for 2e-9 ((h_a + h_b)^2 + |d|^2) below (m_a + m_b)^2
+// against rounding. About 30 instructions against ~500 for the full 15-axis test on overlapping
+// boxes (every axis tried). Boxes that are not elongated have segments of length ~0: the test is
+// then that of the inscribed spheres. d: b's centre (at its image) minus a's.
 inline bool obb_inner_capsules_meet(const Obb& a, const ObbCore& ca, const Obb& b, const ObbCore& cb,
                                     const Vec3& d) {
   const Vec3 u = a.axes.col(ca.axis), v = b.axes.col(cb.axis);
