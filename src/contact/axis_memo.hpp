@@ -52,10 +52,7 @@ class AxisMemo {
   }
   // The pair's axis from i to j: i's slot for j, else j's slot for i negated.
   bool find_either(std::uint32_t i, std::uint32_t j, Vec3& n) const {
-    if (find(i, j, n)) return true;
-    if (!find(j, i, n)) return false;
-    n = -n;
-    return true;
+    return find(i, j, n) || find_from_partner(i, j, n);
   }
   // For the pre-filter of every candidate (system/rigid_bodies.hpp, memo_or_centres_clear_time):
   // find_either while the memo holds at most kPartnerSideBodies bodies (2 MB, within a core's
@@ -68,10 +65,8 @@ class AxisMemo {
   // (The size is compared only after the own slot missed: e1 asks ~34 times a collision.)
   static constexpr std::size_t kPartnerSideBodies = 2048;
   bool find_near(std::uint32_t i, std::uint32_t j, Vec3& n) const {
-    if (find(i, j, n)) return true;
-    if (slots_.size() > kPartnerSideBodies * kSlots || !find(j, i, n)) return false;
-    n = -n;
-    return true;
+    return find(i, j, n) ||
+           (slots_.size() <= kPartnerSideBodies * kSlots && find_from_partner(i, j, n));
   }
   // Axis n of a solve or the contact normal of a collision of i and j (from i to j), for both
   // sides (see the header).
@@ -113,6 +108,12 @@ class AxisMemo {
   }
 
  private:
+  // j's slot for i, negated: the axis from i to j (n unchanged on a miss).
+  bool find_from_partner(std::uint32_t i, std::uint32_t j, Vec3& n) const {
+    if (!find(j, i, n)) return false;
+    n = -n;
+    return true;
+  }
   struct Slot {
     Vec3 n = Vec3::Zero();
     std::uint32_t j = kNone;
