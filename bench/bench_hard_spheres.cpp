@@ -3,7 +3,8 @@
 //                           [reorder]
 // engine = generic (default): the generic event loop, with cell lists (shell = 0) or neighbour
 // lists with that shell; engine = fast: the dedicated hard-sphere loop (system/sphere_engine.hpp)
-// with cages of diameter shell (0: 0.5, the fastest at phi 0.45; see docs/benchmarks), its records
+// with cages of diameter shell (0: SphereEngine::default_shell, the fastest at phi 0.45 for the
+// size: 0.5 up to N = 160000, 0.6, then 0.65 from N = 640000; see docs/benchmarks), its records
 // re-sorted along the curve every `reorder` N events (default 16; 0: never).
 // Prints one JSON line per run (machine-readable).
 #include <cstdio>
@@ -32,7 +33,7 @@ int main(int argc, char** argv) {
   const std::string engine = argc > 6 ? argv[6] : "generic";
   const double reorder = argc > 7 ? std::atof(argv[7]) : 16.0;
   if (engine == "fast") {
-    if (spec.shell == 0.0) spec.shell = 0.5;
+    if (spec.shell == 0.0) spec.shell = SphereEngine::default_shell(spec.n, spec.phi, spec.sigma);
     return bench_fast(spec, coll, equil, reorder);
   }
   if (engine != "generic") {

@@ -10,7 +10,7 @@
 //   inertia eps_d seed method shell] collisions=5000 (rigid bodies) sphere_collisions=
 //   20*collisions warmup=1000 (each engine) rounds=10 sphere_shell=0 (0: cells)
 //   sphere_engine=generic|fast (fast: the dedicated hard-sphere loop, system/sphere_engine.hpp,
-//   with cages of sphere_shell, 0: 0.5)
+//   with cages of sphere_shell, 0: SphereEngine::default_shell, 0.5 at small N)
 // Prints one JSON line: tau_c_us of A and B, ratio B/A, its spread over the rounds.
 #include <array>
 #include <cstdio>
@@ -91,7 +91,8 @@ int run(int argc, char** argv) {
   if (sphere_engine != "generic" && sphere_engine != "fast")
     throw std::invalid_argument("sphere_engine must be generic or fast");
   if (pair == "spheres" && sphere_engine == "fast") {
-    const double shell = sphere_shell > 0 ? sphere_shell : 0.5;
+    const double shell =
+        sphere_shell > 0 ? sphere_shell : hb::SphereEngine::default_shell(pt.spec.n, pt.spec.phi);
     j["A_engine"] = "hard spheres, dedicated loop";
     j["A_shell"] = shell;
     j["B_engine"] = "ellipsoids";

@@ -65,8 +65,9 @@
 # interval loops once over the N spheres (at most one sphere visit per ~20 collisions: negligible).
 #
 # Our side: ./build/bench/bench_hard_spheres N 0.45 C 20N 0 ENGINE (ENGINE = fast, the default:
-# the dedicated hard-sphere loop with cages of 0.2 sigma; --engine generic: the generic event loop
-# with cell lists), which
+# the dedicated hard-sphere loop with its default cages, SphereEngine::default_shell: 0.5 sigma
+# up to N = 160000, 0.6 and 0.65 sigma beyond, the fastest for the size at phi = 0.45;
+# --engine generic: the generic event loop with cell lists), which
 # equilibrates 20 N collisions and then times C collisions in-process (CLOCK_PROCESS_CPUTIME_ID);
 # its collisions_per_second is used. The whole process is also timed (GNU time) for its max RSS.
 #

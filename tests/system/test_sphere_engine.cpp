@@ -147,3 +147,33 @@ TEST(SphereEngine, RejectsBadInput) {
   SphereEngine still(box, rest, 1.0, 0.2);
   EXPECT_THROW(still.step(), std::runtime_error);
 }
+
+// The default cage: 0.5 sigma for small systems, larger ones beyond the caches, never so large
+// that a sphere lists more than about 16.5 others on average; and a run at the largest default
+// cages, at phi = 0.45 and in a denser fluid, keeps its lists within their 24 slots (the engine
+// throws when one overflows) and leaves no overlap.
+TEST(SphereEngine, DefaultCagesKeepTheListsShort) {
+  EXPECT_EQ(SphereEngine::default_shell(4000, 0.45), 0.5);
+  EXPECT_EQ(SphereEngine::default_shell(1000000, 0.45), 0.65);
+  EXPECT_EQ(SphereEngine::default_shell(1000000, 0.45, 2.0), 1.3);  // in units of sigma
+  for (double phi : {0.1, 0.3, 0.45, 0.5, 0.55, 0.6, 0.7}) {
+    double last = 0.0;
+    for (std::size_t n : {256u, 4000u, 160000u, 256000u, 640000u, 1000000u}) {
+      const double s = SphereEngine::default_shell(n, phi);
+      const double listed = 8.0 * phi * std::pow(1.0 + s, 3);  // rho 4 pi (1 + s)^3 / 3
+      EXPECT_LE(listed, 16.5 * (1.0 + 1e-12)) << "phi " << phi << " n " << n;
+      EXPECT_GT(s, 0.3) << "phi " << phi << " n " << n;
+      EXPECT_GE(s, last) << "phi " << phi << " n " << n;  // never smaller for more spheres
+      last = s;
+    }
+  }
+  for (double phi : {0.45, 0.5}) {
+    SphereSystemSpec spec;
+    spec.n = 4000, spec.phi = phi, spec.seed = 5;
+    Box box;
+    const double shell = SphereEngine::default_shell(1000000, phi);
+    SphereEngine e(box, hard_sphere_start(spec, box), 1.0, shell);
+    while (e.collisions() < 100000) e.step();
+    EXPECT_GT(worst_gap(e.state(), box, 1.0), -1e-10) << "phi " << phi;
+  }
+}
