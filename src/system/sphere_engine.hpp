@@ -145,13 +145,14 @@ class SphereEngine {
   // average (rho 4 pi (sigma + s)^3 / 3 <= 16.5, rho = 6 phi / (pi sigma^3); the lists hold
   // kMaxNeighbours = 24, and a cage of 0.8 sigma, 21 on average, overflowed them at 0.45).
   // A bigger cage means fewer cage exits (each scans 27 grid cells and edits about 25 lists)
-  // but longer lists for every prediction.  While the arrays stay below kFarBytes (n < 160000,
-  // ~210 bytes a sphere) an exit's loads hit the caches and 0.5 sigma is fastest (N = 4000:
+  // but longer lists for every prediction.  While the arrays stay below kFarBytes (n <
+  // kFarSpheres) an exit's loads hit the caches and 0.5 sigma is fastest (N = 4000:
   // 0.6 costs 1 %, 0.7 1 %; N = 32000: 0.6 0.4 %, 0.65 6 %).  Beyond, an exit's loads miss:
   // N = 256000: 0.6 is 3 % faster than 0.5 (0.65 0 %); N = 10^6: 0.6 -8 %, 0.65 -12 % (alternating
   // runs, docs/benchmarks/README.md, session of 2026-12-07, third part).
+  static constexpr std::size_t kFarSpheres = 160000;  // ~kFarBytes at ~210 bytes a sphere
   static double default_shell(std::size_t n, double phi, double sigma = 1.0) {
-    const double s = n < 160000 ? 0.5 : n < 640000 ? 0.6 : 0.65;
+    const double s = n < kFarSpheres ? 0.5 : n < 4 * kFarSpheres ? 0.6 : 0.65;
     if (!(phi > 0.0)) return s * sigma;
     // (sigma + s)^3 <= 16.5 sigma^3 / (8 phi)
     const double cap = std::cbrt(16.5 / (8.0 * phi)) - 1.0;
