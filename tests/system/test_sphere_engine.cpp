@@ -125,6 +125,9 @@ TEST(SphereEngine, NoOverlapsAndConservation) {
   EXPECT_GT(worst, -1e-10);
   EXPECT_LT(std::abs(drift), 1e-12);
   EXPECT_LT((momentum(s) - p0).norm(), 1e-10);
+  // A pair that comes after the partner's own event is left to the partner (sphere_engine.hpp):
+  // 0.12 stale events a collision here, 0.42 when every prediction took its earliest pair.
+  EXPECT_LT(fast.stale_events(), fast.collisions() / 4);
 }
 
 TEST(SphereEngine, RejectsBadInput) {
