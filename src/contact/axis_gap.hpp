@@ -485,10 +485,9 @@ inline double next_up(double x) {
 // tau_c is a time just past span: the root is not formed), else tau_c = t1. Pairs without a
 // bounded curvature take the affine F instead of Q (a finite span only): F > margin at both
 // ends gives a time just past span (the window is covered; F says nothing beyond it), else the
-// larger of t1 and the chord's zero. A
-// first-order t1 beyond `span` (the caller's window) is returned as it is: the second order is
-// not needed. clear_along_axis is tau_c > span. The prediction loop (system/rigid_bodies.hpp,
-// predict_contacts) orders its candidates by tau_c.
+// larger of t1 and the chord's zero. A first-order t1 beyond `span` (the caller's window) is
+// returned as it is: the second order is not needed. clear_along_axis is tau_c > span. The
+// prediction loop (system/rigid_bodies.hpp, predict_contacts) orders its candidates by tau_c.
 template <SupportShape SA, SupportShape SB, class RA = Quat>
 double axis_clear_time(const SA& sa, const RA& qa, const Vec3& wa, const SB& sb, const Quat& qb,
                        const Vec3& wb, const Vec3& c, const Vec3& u, const Vec3& dv, double age,
