@@ -217,7 +217,7 @@ TEST(AxisGap, ClearAlongCentresIsBelowTheGapAlongThemForAsymmetricTops) {
 void check_second_order_clear(std::uint64_t seed, bool tops) {
   Rng r(seed);
   const int n = scaled_count(2000, 0.1);
-  int first = 0, second = 0, clear_times = 0;
+  int first = 0, second = 0, clear_times = 0, shortcut = 0;
   double worst = -kInf, frame_worst = 0.0;
   for (int k = 0; k < n; ++k) {
     const ClearCase cc = clear_case(r, tops);
@@ -246,6 +246,16 @@ void check_second_order_clear(std::uint64_t seed, bool tops) {
                                       spin(ma), spin(mb), true);
     EXPECT_EQ(quad, tc > span) << k;
     clear_times += tc > 0.0;
+    // With the window's span, a time just past it where Q covers the window (no root formed),
+    // else the same time as the whole bound's (the root, or t1)
+    const double ts = axis_clear_time(p.a, qa, wa, p.b, p.sb.q, p.sb.w, c, u, dv, age, span,
+                                      spin(ma), spin(mb), true);
+    if (ts > span && tc > span) {
+      EXPECT_LE(ts, tc) << k;
+      shortcut += ts == std::nextafter(span, kInf) && tc > ts;
+    } else {
+      EXPECT_EQ(ts, tc) << k;
+    }
     // A's rotation as a matrix (RotationFrame: the prediction loop's form) gives the same time
     // to rounding
     const double tf = axis_clear_time(p.a, RotationFrame(qa), wa, p.b, p.sb.q, p.sb.w, c, u, dv,
@@ -288,10 +298,12 @@ void check_second_order_clear(std::uint64_t seed, bool tops) {
       }
     }
   }
-  std::printf("  %d pairs%s: %d clear to first order, %d with the second, %d with a clear time "
-              "> 0, max (Q - g_u) %.2e, matrix vs quaternion %.1e\n", n,
-              tops ? " (asymmetric tops)" : "", first, second, clear_times, worst, frame_worst);
+  std::printf("  %d pairs%s: %d clear to first order, %d with the second (%d without the root), "
+              "%d with a clear time > 0, max (Q - g_u) %.2e, matrix vs quaternion %.1e\n", n,
+              tops ? " (asymmetric tops)" : "", first, second, shortcut, clear_times, worst,
+              frame_worst);
   EXPECT_GT(clear_times, second);
+  EXPECT_GT(shortcut, 0);  // the window answered without the root is exercised
   EXPECT_LE(worst, 1e-8);  // central differences: rates to ~1e-10
   EXPECT_GT(second, first + n / 50);
   EXPECT_LT(second, n);
