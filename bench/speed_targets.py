@@ -249,8 +249,9 @@ def peer_rows(a, out):
     return rows
 
 
-def fmt(v, digits=3):
-    return "—" if v is None else (f"{v:.{digits}g}" if abs(v) < 100 else f"{v:.0f}")
+def fmt(v, digits=3, zeros=False):
+    # zeros: keep trailing zeros (0.24997 prints 0.2500, not 0.25, beside a threshold of 0.25)
+    return "—" if v is None else (f"{v:{'#' if zeros else ''}.{digits}g}" if abs(v) < 100 else f"{v:.0f}")
 
 
 
@@ -289,7 +290,7 @@ def report(rows, meta, path):
         if r.get("date") and r["date"] != meta["date"]:
             extra += f" [kept from the run of {r['date']}, commit {r.get('commit', '?')}]"
         # the value with one digit more than the rest: e1's 0.2505 must not print as its threshold
-        lines.append(f"| {r['what']} | {fmt(r['value'], 4)}{extra} | {r['threshold']} | {verdict} | {per} |")
+        lines.append(f"| {r['what']} | {fmt(r['value'], 4, zeros=True)}{extra} | {r['threshold']} | {verdict} | {per} |")
     lines += ["", "The last column: the ratio in each round (ours / peer for the hard spheres), so the spread can be "
               "read; the rows without it are derived from the hard-sphere runs above.", "", "## Commands", ""]
     for r in rows:

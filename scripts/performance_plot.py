@@ -1041,7 +1041,8 @@ def speed_targets(rep, path):
         v = r.get("value")
         if v is None:
             return "not measured"
-        s = f"{v:.4g}" if abs(v) < 100 else f"{v:.0f}"  # 4 digits: 0.2505 is not <= 0.25
+        # 4 digits with their trailing zeros: 0.2505 is not <= 0.25, and 0.24997 prints 0.2500
+        s = f"{v:#.4g}" if abs(v) < 100 else f"{v:.0f}"
         if r.get("date") and r["date"] != meta.get("date"):
             s += f" (run of {r['date']})"
         return s
