@@ -531,7 +531,7 @@ double axis_clear_time(const SA& sa, const RA& qa, const Vec3& wa, const SB& sb,
     const double f0 = g_old - age * (sb.bounding_radius() * db.norm() + 0.5 * Qb * age) - margin;
     if (!(f0 > 0.0)) return t1;
     const double fs = F(span);
-    if (fs > 0.0) return std::max(t1, std::nextafter(span, kInf));
+    if (fs > 0.0) return std::max(t1, next_up(span));  // span >= t1 >= 0, finite here
     return std::max(t1, span * (f0 / (f0 - fs)));
   }
   if constexpr (AxisGap<SA, SB>::kMayCurve) {
