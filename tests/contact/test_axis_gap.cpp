@@ -5,7 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <vector>
 
 #include "contact/axis_gap.hpp"
@@ -312,6 +316,22 @@ void check_second_order_clear(std::uint64_t seed, bool tops) {
 TEST(AxisGap, SecondOrderClearIsBelowTheGapAlongItsAxis) { check_second_order_clear(97, false); }
 TEST(AxisGap, SecondOrderClearIsBelowTheGapAlongItsAxisForAsymmetricTops) {
   check_second_order_clear(101, true);
+}
+
+// next_up, the time just past a window that both the second order and the affine bound return,
+// against its slow twin std::nextafter(x, +inf), bit for bit: zero, subnormals, the ends of the
+// binades, ordinary spans, the largest finite double (-> inf).
+TEST(AxisGap, NextUpIsNextafterTowardsInfinity) {
+  const double big = std::numeric_limits<double>::max();
+  std::vector<double> xs = {0.0, std::numeric_limits<double>::denorm_min(), 1e-310,
+                            std::numeric_limits<double>::min(), 1e-300, 0.5, 1.0,
+                            std::nextafter(1.0, 0.0), 2.0, 3.0, 1e300, big};
+  for (int k = 1; k <= 1000; ++k) xs.push_back(std::ldexp(1.0 + k * 0.000999, k % 61 - 30));
+  for (const double x : xs)
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(next_up(x)),
+              std::bit_cast<std::uint64_t>(std::nextafter(x, kInf)))
+        << x;
+  EXPECT_TRUE(std::isinf(next_up(big)));
 }
 
 // The affine clear time of flat-faced pairs (axis_clear_time with second_order = true where a
