@@ -515,6 +515,61 @@ TEST(EscapeTime, OneSidedStepsGiveTheSameEscapesInFewerSteps) {
   EXPECT_LT(steps_q[1], steps_q[0]);
 }
 
+// FirstRootOptions::skip_covered_end: a search whose last step is covered to the window's end
+// by every face's rigorous step answers none without the values there. Against the twin that
+// evaluates them, on ellipsoid flights (second-order steps, and Lipschitz steps alone) and
+// flat-faced ones (affine steps, and Lipschitz steps alone), with windows cut short so that
+// most searches end inside: every field of the result the same, bit for bit, and an
+// evaluation fewer where the shortcut was taken (never more than one).
+TEST(EscapeTime, CoveredWindowEndEndsTheSearchWithoutItsValues) {
+  testing::Rng r(577);
+  const int n = hb::testing::scaled_count(2000, 0.05);
+  long none = 0, skipped = 0, evals[2] = {0, 0};
+  auto compare = [&](const auto& in, int k, EscapeOptions o) {
+    using S = std::decay_t<decltype(in.shape)>;
+    const BoxDistance<S> D(in.shape, in.body, in.t_state, in.box, in.margin, in.scale,
+                           in.scale_rate, in.t_max, in.revolution);
+    EscapeOptions twin = o;
+    twin.skip_covered_end = false;
+    const FirstRoot a = first_root(D, in.t_start, in.t_max, in.eps, twin);
+    const FirstRoot b = first_root(D, in.t_start, in.t_max, in.eps, o);
+    ASSERT_EQ(a.status, b.status) << "case " << k;
+    EXPECT_EQ(a.time, b.time) << "case " << k;
+    EXPECT_EQ(a.component, b.component) << "case " << k;
+    EXPECT_EQ(a.value, b.value) << "case " << k;
+    EXPECT_EQ(a.steps, b.steps) << "case " << k;
+    EXPECT_EQ(a.bounds, b.bounds) << "case " << k;
+    EXPECT_EQ(a.grazing_searches, b.grazing_searches) << "case " << k;
+    EXPECT_EQ(a.truncated, b.truncated) << "case " << k;
+    ASSERT_TRUE(a.evaluations == b.evaluations ||
+                (a.status == RootStatus::none && a.evaluations == b.evaluations + 1))
+        << "case " << k << ": " << a.evaluations << " against " << b.evaluations;
+    evals[0] += a.evaluations, evals[1] += b.evaluations;
+    if (a.status == RootStatus::none) ++none, skipped += a.evaluations - b.evaluations;
+  };
+  EscapeOptions lipschitz;
+  lipschitz.second_order = false, lipschitz.affine_steps = false, lipschitz.one_sided = false;
+  // a window of 0.1 to 30 times the time the body needs to cross its shell at its speed bound
+  auto cut = [&](double& t_max, const Obb& box, const Vec3& ext, double K) {
+    t_max = std::min(t_max, r.log_uni(0.1, 30.0) * (box.half - ext).minCoeff() / K);
+  };
+  for (int k = 0; k < n; ++k) {
+    Flight f = random_flight(r);
+    cut(f.t_max, f.box, f.e.half_extents(), f.s.v.norm() + f.s.w.norm() * f.e.bounding_radius());
+    compare(f.input(), k, EscapeOptions{});
+    compare(f.input(), k, lipschitz);
+    FlatFlight q = random_flat_flight(r, k);
+    cut(q.t_max, q.box, q.q.half_extents(), q.s.v.norm() + q.s.w.norm() * q.q.bounding_radius());
+    compare(q.input(), k, EscapeOptions{});
+    compare(q.input(), k, lipschitz);
+  }
+  std::printf("[ ESCAPE ] %d searches, %ld end inside, %ld of them without the window end's "
+              "values: evaluations %ld -> %ld\n", 4 * n, none, skipped, evals[0], evals[1]);
+  EXPECT_GT(none, n);            // most of the 4 n searches end inside
+  EXPECT_GT(2 * skipped, none);  // and most of those take the shortcut
+  EXPECT_EQ(evals[0] - evals[1], skipped);
+}
+
 TEST(EscapeTime, AlreadyOutsideGivesStartTime) {
   const Ellipsoid e{1.0, 0.5, 0.25};
   BodyState s;
