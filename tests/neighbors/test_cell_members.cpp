@@ -58,13 +58,14 @@ TEST(CellMembers, HoldWhatTheLinkedCellsHold) {
   for (std::uint32_t c = 0; c < cells.n_cells(); ++c) {
     std::set<std::uint32_t> linked, packed;
     for (std::uint32_t j = cells.head(c); j != CellList::kNone; j = cells.next(j)) linked.insert(j);
-    for (const CellMembers::Member* m = members.begin(c); m != members.end(c); ++m) {
-      packed.insert(m->id);
-      EXPECT_LE((m->centre() - r[m->id]).norm(), members.rounding_bound());
-      const Vec3 h = members.half(m).value(), want = half_of(m->id);
+    for (std::uint32_t k = 0; k < members.size(c); ++k) {
+      const CellMembers::Member m = members.member(c, k);
+      packed.insert(m.id);
+      EXPECT_LE((m.centre() - r[m.id]).norm(), members.rounding_bound());
+      const Vec3 h = members.half(c, k).value(), want = half_of(m.id);
       for (int a = 0; a < 3; ++a) {  // rounded up to single precision
-        EXPECT_GE(h[a], want[a]) << "body " << m->id;
-        EXPECT_LE(h[a], want[a] * (1.0 + 2.5e-7)) << "body " << m->id;
+        EXPECT_GE(h[a], want[a]) << "body " << m.id;
+        EXPECT_LE(h[a], want[a] * (1.0 + 2.5e-7)) << "body " << m.id;
       }
     }
     EXPECT_EQ(packed, linked) << "cell " << c;
@@ -76,8 +77,8 @@ TEST(CellMembers, HoldWhatTheLinkedCellsHold) {
     std::multiset<std::tuple<std::uint32_t, double, double, double>> a, b;
     cells.for_each_neighbor(i, box.L, [&](std::uint32_t j, const Vec3& s) { a.insert({j, s.x(), s.y(), s.z()}); });
     cells.for_each_stencil_cell(i, box.L, [&](std::uint32_t c, const Vec3& s) {
-      for (const CellMembers::Member* m = members.begin(c); m != members.end(c); ++m)
-        b.insert({m->id, s.x(), s.y(), s.z()});
+      for (std::uint32_t k = 0; k < members.size(c); ++k)
+        b.insert({members.member(c, k).id, s.x(), s.y(), s.z()});
     });
     EXPECT_EQ(a, b) << "body " << i;
   }
@@ -115,7 +116,7 @@ TEST(CellMembers, WalkFindsTheMembersWithinReach) {
       max_abs = std::max(max_abs, c.cwiseAbs().maxCoeff());
     }
     members.remove(0, 100 + trial % (n + 2));  // a hole, filled by the last member
-    members.remove(0, (members.end(0) - 1)->id);
+    members.remove(0, members.member(0, members.size(0) - 1).id);
     ASSERT_EQ(members.size(0), n);
     std::multiset<std::uint32_t> got;
     std::vector<std::uint32_t> order;  // reported in the members' order
@@ -125,16 +126,17 @@ TEST(CellMembers, WalkFindsTheMembersWithinReach) {
     });
     {
       std::size_t at = 0;
-      for (const CellMembers::Member* m = members.begin(0); m != members.end(0) && at < order.size(); ++m)
-        if (m->id == order[at]) ++at;
+      for (std::uint32_t k = 0; k < members.size(0) && at < order.size(); ++k)
+        if (members.member(0, k).id == order[at]) ++at;
       EXPECT_EQ(at, order.size()) << "trial " << trial << ": not in the members' order";
     }
     const double S = max_abs + from.cwiseAbs().maxCoeff() + reach + L.head<2>().maxCoeff();
     std::set<std::uint32_t> all;
-    for (const CellMembers::Member* m = members.begin(0); m != members.end(0); ++m) {
-      const std::uint32_t j = m->id;
+    for (std::uint32_t k = 0; k < members.size(0); ++k) {
+      const CellMembers::Member m = members.member(0, k);
+      const std::uint32_t j = m.id;
       all.insert(j);
-      Vec3 d = m->centre() - from;
+      Vec3 d = m.centre() - from;
       for (int a = 0; a < 3; ++a) d[a] = std::min(std::abs(d[a]), period[a] - std::abs(d[a]));
       const double dist = d.norm();
       if (std::abs(dist - reach) < 1e-5) ++near_cut;
@@ -197,9 +199,10 @@ TEST(CellMembers, WalkSkipsTheMembersWhoseBoxesLieApart) {
     members.for_each_within_box(0, from, period, reach, hq, [&](std::uint32_t j) { got.insert(j); });
     const double S = max_abs + from.cwiseAbs().maxCoeff() + reach + L.head<2>().maxCoeff();
     const double slack = 1e-5 * S + 1e-9;
-    for (const CellMembers::Member* m = members.begin(0); m != members.end(0); ++m) {
-      const std::uint32_t j = m->id;
-      Vec3 d = m->centre() - from;
+    for (std::uint32_t k = 0; k < members.size(0); ++k) {
+      const CellMembers::Member m = members.member(0, k);
+      const std::uint32_t j = m.id;
+      Vec3 d = m.centre() - from;
       for (int a = 0; a < 3; ++a) d[a] = std::min(std::abs(d[a]), period[a] - std::abs(d[a]));
       const Vec3 gap = d - hq - half[j];  // > 0 along an axis: the boxes lie apart there
       if (gap.cwiseAbs().minCoeff() < 1e-6) ++near_face;
