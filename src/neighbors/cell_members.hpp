@@ -6,14 +6,15 @@
 // pointer per body, each load waiting for the one before, and reads each body's record for its
 // centre: at N = 256000 ellipsoids that walk and those loads were 8-9 % of the run (perf; the
 // rebuild of one box meets ~330 bodies in its 27 cells). Here a cell's members are 16 bytes
-// each, side by side: the walk reads a few lines per cell, all of them independent.
+// each (and 16 more for their boxes), side by side: the walk reads a few lines per cell, all of
+// them independent.
 //
 // Layout: a cell's members in blocks of four, each block one cache line of the four centres'
 // x, then y, then z, then ids (and a second array of blocks of their boxes' half-extents), so
 // that the walk tests four members with each vector operation. Measured (callgrind, ellipsoids
 // X0 = 2 at phi = 0.5, N = 256, where a rebuild walks every body: docs/benchmarks/README.md,
 // "Session of 2026-12-07, seventh part"): the walk with boxes took 38 instructions a member
-// with one member (x, y, z, id) a vector.
+// with one member (x, y, z, id) a vector, 18 in blocks of four.
 //
 // Capacity: the same for every cell, twice the mean occupancy plus 8 rounded up to whole blocks
 // (the grid should have at most one cell per body: capped_cell_width's max_per_body = 1),
