@@ -84,7 +84,7 @@ class AxisMemo {
 
   // A hint: body i's slots (1 kB), ahead of a prediction of i (at N = 256000 they are not in
   // any cache).
-  void prefetch(std::uint32_t i) const {
+  [[gnu::always_inline]] void prefetch(std::uint32_t i) const {
     if (std::size_t(i + 1) * kSlots > slots_.size()) return;
     const char* p = reinterpret_cast<const char*>(slots_.data() + std::size_t(i) * kSlots);
     for (std::size_t b = 0; b < kSlots * sizeof(Slot); b += 64) __builtin_prefetch(p + b);

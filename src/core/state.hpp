@@ -127,7 +127,7 @@ struct State : HotArrays {
   // Ask the memory system for body i's stored state ahead of its use (a hint, no effect on any
   // result): the prediction loop touches neighbours' records from all over the box, and each
   // contact-time solve is long enough to hide the next one's cache misses.
-  void prefetch(std::size_t i) const {
+  [[gnu::always_inline]] void prefetch(std::size_t i) const {
     const char* p = reinterpret_cast<const char*>(&hot_[i]);
     __builtin_prefetch(p);
     __builtin_prefetch(p + 64);

@@ -46,7 +46,7 @@ class CalendarQueue {
   // find it, which changes no event).
   const Event& top() const { return ev_[cal_.top()]; }
   const Event& event_of(std::uint32_t i) const { return ev_[i]; }
-  void prefetch(std::uint32_t i) const { __builtin_prefetch(&ev_[i]); }
+  [[gnu::always_inline]] void prefetch(std::uint32_t i) const { __builtin_prefetch(&ev_[i]); }
 
  private:
   std::vector<Event> ev_;

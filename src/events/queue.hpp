@@ -44,7 +44,7 @@ class IndexedHeap {
   }
   const Event& top() const { return ev_[heap_[0]]; }
   const Event& event_of(std::uint32_t i) const { return ev_[i]; }
-  void prefetch(std::uint32_t i) const { __builtin_prefetch(&ev_[i]); }  // a hint, ahead of event_of(i)
+  [[gnu::always_inline]] void prefetch(std::uint32_t i) const { __builtin_prefetch(&ev_[i]); }  // a hint, ahead of event_of(i)
 
  private:
   bool less(std::uint32_t a, std::uint32_t b) const { return earlier(ev_[a], ev_[b]); }

@@ -248,7 +248,7 @@ class ObbNeighbors {
 
   // A hint: body i's box and list, ahead of a prediction of i (system/simulation.hpp issues it
   // before a collision's impulse, whose distance solve hides the cache misses at large N).
-  void prefetch(std::uint32_t i) const {
+  [[gnu::always_inline]] void prefetch(std::uint32_t i) const {
     const char* b = reinterpret_cast<const char*>(&obb_[i]);
     __builtin_prefetch(b);
     __builtin_prefetch(b + 64);

@@ -52,7 +52,7 @@ class AdjacencyLists {
   void clear(std::uint32_t i) { size_[i] = 0; }
   // A hint: list i's length and its first two cache lines (a list of ~30 entries), ahead of
   // reading it.
-  void prefetch(std::uint32_t i) const {
+  [[gnu::always_inline]] void prefetch(std::uint32_t i) const {
     __builtin_prefetch(&size_[i]);
     __builtin_prefetch(begin(i));
     __builtin_prefetch(begin(i) + 16);

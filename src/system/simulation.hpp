@@ -315,7 +315,13 @@ class Simulation {
   }
   // Hints for a body about to be predicted: its neighbour policy's records (ObbNeighbors: box
   // and list), if the policy offers them, and its slots of the model's memo, if it keeps one.
-  void prefetch_neighbors(std::uint32_t i) const {
+  // Every hint function is always_inline: GCC 12 counts __builtin_prefetch as free of side
+  // effects, so a const function made of prefetches alone is found pure (ipa-pure-const) and
+  // its call deleted as dead code before the inliner reaches it. That had silently deleted
+  // ObbNeighbors::prefetch here (never executed), and AxisMemo::prefetch whenever the code
+  // around it changed shape (its hint is worth ~10 % at N = 256000); inlined first, the
+  // prefetches stay (docs/benchmarks/README.md, "Session of 2026-12-08").
+  [[gnu::always_inline]] void prefetch_neighbors(std::uint32_t i) const {
     if constexpr (requires { nb_.prefetch(i); }) nb_.prefetch(i);
     if constexpr (requires { model_.memo.prefetch(i); }) model_.memo.prefetch(i);  // AxisMemo
   }
