@@ -59,20 +59,19 @@ class CellMembers {
   void init(std::size_t n_cells, std::size_t n_bodies) {
     const double mean = n_cells > 0 ? double(n_bodies) / double(n_cells) : 0.0;
     cap_ = whole_blocks(static_cast<std::uint32_t>(std::ceil(2.0 * mean)) + 8);
-    data_.assign(n_cells * (cap_ / kLanes), Block{});
-    half_.assign(n_cells * (cap_ / kLanes), Block{});
+    data_.assign(n_cells * (cap_ / kLanes), Pair{});
     size_.assign(n_cells, 0);
     max_abs_ = 0.0;
   }
   std::uint32_t size(std::uint32_t cell) const { return size_[cell]; }
   // Member k < size(cell) of a cell, and its box's half-extents.
   Member member(std::uint32_t cell, std::uint32_t k) const {
-    const Block& b = block(data_, cell, k);
+    const Block& b = pair(cell, k).m;
     const std::uint32_t l = k % kLanes;
     return Member{b.x[l], b.y[l], b.z[l], b.id[l]};
   }
   Half half(std::uint32_t cell, std::uint32_t k) const {
-    const Block& b = block(half_, cell, k);
+    const Block& b = pair(cell, k).h;
     const std::uint32_t l = k % kLanes;
     return Half{b.x[l], b.y[l], b.z[l]};
   }
@@ -89,9 +88,9 @@ class CellMembers {
   }
   void remove(std::uint32_t cell, std::uint32_t id) {
     const std::uint32_t n = size_[cell];
-    const Block* b = data_.data() + std::size_t(cell) * (cap_ / kLanes);
+    const Pair* b = data_.data() + std::size_t(cell) * (cap_ / kLanes);
     std::uint32_t k = 0;
-    while (k < n && b[k / kLanes].id[k % kLanes] != id) ++k;
+    while (k < n && b[k / kLanes].m.id[k % kLanes] != id) ++k;
     if (k == n) throw std::logic_error("cell members: body not in its cell");
     put(cell, k, member(cell, n - 1), half(cell, n - 1));
     --size_[cell];
@@ -153,15 +152,21 @@ class CellMembers {
     std::uint32_t id[kLanes] = {};
   };
   static std::uint32_t whole_blocks(std::uint32_t n) { return (n + kLanes - 1) / kLanes * kLanes; }
-  const Block& block(const std::vector<Block>& v, std::uint32_t cell, std::uint32_t k) const {
-    return v[(std::size_t(cell) * cap_ + k) / kLanes];
+  // A block of members and the block of their boxes' half-extents, side by side: the two lines
+  // of an aligned pair, which the hardware fetches together (at large N the walk with boxes
+  // missed each of them on its own when they lay in two arrays).
+  struct alignas(128) Pair {
+    Block m, h;
+  };
+  const Pair& pair(std::uint32_t cell, std::uint32_t k) const {
+    return data_[(std::size_t(cell) * cap_ + k) / kLanes];
   }
   void put(std::uint32_t cell, std::uint32_t k, const Member& m, const Half& h) {
     const std::size_t at = std::size_t(cell) * cap_ + k;
     const std::uint32_t l = k % kLanes;
-    Block& b = data_[at / kLanes];
+    Block& b = data_[at / kLanes].m;
     b.x[l] = m.x, b.y[l] = m.y, b.z[l] = m.z, b.id[l] = m.id;
-    Block& c = half_[at / kLanes];
+    Block& c = data_[at / kLanes].h;
     c.x[l] = h.x, c.y[l] = h.y, c.z[l] = h.z;
   }
 
@@ -190,13 +195,14 @@ class CellMembers {
     // fn is called for each, in the members' order.
     constexpr std::uint32_t kBuffer = 64;
     std::uint32_t pass[kBuffer];
-    const Block* b = data_.data() + std::size_t(cell) * (cap_ / kLanes);
-    const Block* hb = half_.data() + std::size_t(cell) * (cap_ / kLanes);
+    const Pair* pb = data_.data() + std::size_t(cell) * (cap_ / kLanes);
     const std::uint32_t n = size_[cell];
     for (std::uint32_t k = 0; k < n;) {
       const std::uint32_t stop = std::min(n, k + kBuffer);
       int m = 0;
-      for (; k < stop; k += kLanes, ++b, ++hb) {
+      for (; k < stop; k += kLanes, ++pb) {
+        const Block* b = &pb->m;
+        const Block* hb = &pb->h;
         F4 x[3], v;
         for (int a = 0; a < 3; ++a) {
           std::memcpy(&v, a == 0 ? b->x : a == 1 ? b->y : b->z, sizeof v);
@@ -225,19 +231,16 @@ class CellMembers {
 
   void grow() {
     const std::uint32_t cap = 2 * cap_;
-    std::vector<Block> d(size_.size() * (cap / kLanes)), h(size_.size() * (cap / kLanes));
+    std::vector<Pair> d(size_.size() * (cap / kLanes));
     for (std::size_t c = 0; c < size_.size(); ++c) {
       const std::size_t blocks = (size_[c] + kLanes - 1) / kLanes;
       std::copy_n(data_.begin() + c * (cap_ / kLanes), blocks, d.begin() + c * (cap / kLanes));
-      std::copy_n(half_.begin() + c * (cap_ / kLanes), blocks, h.begin() + c * (cap / kLanes));
     }
     data_.swap(d);
-    half_.swap(h);
     cap_ = cap;
   }
   std::uint32_t cap_ = kLanes;  // a multiple of kLanes
-  std::vector<Block> data_;
-  std::vector<Block> half_;  // beside data_, slot for slot
+  std::vector<Pair> data_;  // a cell's blocks of members with their boxes
   std::vector<std::uint32_t> size_;
   double max_abs_ = 0.0;
 };

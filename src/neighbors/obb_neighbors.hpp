@@ -252,7 +252,6 @@ class ObbNeighbors {
     const char* b = reinterpret_cast<const char*>(&obb_[i]);
     __builtin_prefetch(b);
     __builtin_prefetch(b + 64);
-    __builtin_prefetch(b + sizeof(Obb) - 1);
     lists_.prefetch(i);
   }
 
@@ -424,7 +423,7 @@ class ObbNeighbors {
     lists_.init(n, static_cast<std::uint32_t>(std::min<double>(expect + 16, double(n))));
     cells_.init(box.L, reach, n, box.periodic, /*max_per_body=*/1.0);
     members_.init(cells_.n_cells(), n);
-    obb_.assign(n, Obb{});
+    obb_.assign(n, LineObb{});
     q_.assign(n, Quat::Identity());
   }
   // Body i's new box (see "Boxes led along the flight" in the header): the box of the pose
@@ -556,6 +555,7 @@ class ObbNeighbors {
       auto keep = [&](std::uint32_t j) {
         if (!take(j)) return;
         __builtin_prefetch(&obb_[j]);
+        __builtin_prefetch(reinterpret_cast<const char*>(&obb_[j]) + 64);
         near_.push_back({j, shift});
       };
       // j's centre minus ci - shift: the centre separation
@@ -595,7 +595,17 @@ class ObbNeighbors {
   double kbound_l_ = 0.0;    // bounding radius (speed bound of the body's points)
   CellList cells_;           // over box centres; changes only at rebuilds
   CellMembers members_;      // its cells' bodies, packed with their centres (link's walk)
-  std::vector<Obb> obb_;
+  // A box on two whole cache lines (its 120 bytes padded to 128, aligned): the link's overlap
+  // tests read the boxes of a rebuild's ~50 candidates from all over memory at large N, and an
+  // unaligned box of 120 bytes straddled three lines in most slots.
+  struct alignas(64) LineObb : Obb {
+    LineObb& operator=(const Obb& b) {
+      Obb::operator=(b);
+      return *this;
+    }
+  };
+  static_assert(sizeof(LineObb) == 128);
+  std::vector<LineObb> obb_;
   std::vector<Quat> q_;
   std::vector<std::pair<std::uint32_t, Vec3>> near_;  // link's candidates (scratch)
   AdjacencyLists lists_;
