@@ -10,8 +10,9 @@
 // them independent.
 //
 // Layout: a cell's members in blocks of four, each block one cache line of the four centres'
-// x, then y, then z, then ids (and a second array of blocks of their boxes' half-extents), so
-// that the walk tests four members with each vector operation. Measured (callgrind, ellipsoids
+// x, then y, then z, then ids, followed by the block of their boxes' half-extents (an aligned
+// pair of lines, fetched together; in two arrays they missed one by one at large N), so that
+// the walk tests four members with each vector operation. Measured (callgrind, ellipsoids
 // X0 = 2 at phi = 0.5, N = 256, where a rebuild walks every body: docs/benchmarks/README.md,
 // "Session of 2026-12-07, seventh part"): the walk with boxes took 38 instructions a member
 // with one member (x, y, z, id) a vector, 18 in blocks of four.
@@ -64,6 +65,17 @@ class CellMembers {
     max_abs_ = 0.0;
   }
   std::uint32_t size(std::uint32_t cell) const { return size_[cell]; }
+  // A hint: a cell's size and its first `blocks` blocks of four members (with their boxes'
+  // blocks, `boxes`), ahead of a walk. always_inline: a const function of prefetches alone is
+  // found pure by GCC and its calls deleted (system/simulation.hpp, prefetch_neighbors).
+  [[gnu::always_inline]] void prefetch(std::uint32_t cell, int blocks, bool boxes) const {
+    __builtin_prefetch(&size_[cell]);
+    const Pair* p = data_.data() + std::size_t(cell) * (cap_ / kLanes);
+    for (int k = 0; k < blocks; ++k) {
+      __builtin_prefetch(&p[k].m);
+      if (boxes) __builtin_prefetch(&p[k].h);
+    }
+  }
   // Member k < size(cell) of a cell, and its box's half-extents.
   Member member(std::uint32_t cell, std::uint32_t k) const {
     const Block& b = pair(cell, k).m;

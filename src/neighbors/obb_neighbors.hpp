@@ -551,7 +551,19 @@ class ObbNeighbors {
     // i's axis-aligned box, widened like the reach by the centres' rounding (boxes_ only)
     const Vec3 half =
         boxes_ ? Vec3(aabb_half(obb_[i]).array() + members_.rounding_bound()) : Vec3::Zero();
+    // The stencil's cells first (at most 3 x 3 x 3), a hint for each cell's size and first two
+    // blocks of members (and their boxes), then the walk, cell by cell in the same order. At
+    // large N every cell's blocks miss; walked as they came, one cell's loads waited for the
+    // last's (measured at N = 256000: -8 % a collision; docs/benchmarks/README.md, "Session of
+    // 2026-12-08").
+    std::uint32_t cells[27];
+    Vec3 shifts[27];
+    int n_cells = 0;
     cells_.for_each_stencil_cell(i, box.L, [&](std::uint32_t c, const Vec3& shift) {
+      cells[n_cells] = c, shifts[n_cells] = shift, ++n_cells;
+    });
+    for (int k = 0; k < n_cells; ++k) members_.prefetch(cells[k], kWalkHintBlocks, boxes_);
+    auto visit = [&](std::uint32_t c, const Vec3& shift) {
       auto keep = [&](std::uint32_t j) {
         if (!take(j)) return;
         __builtin_prefetch(&obb_[j]);
@@ -561,13 +573,15 @@ class ObbNeighbors {
       // j's centre minus ci - shift: the centre separation
       if (boxes_) members_.for_each_within_box(c, Vec3(ci - shift), fold, reach, half, keep);
       else members_.for_each_within(c, Vec3(ci - shift), fold, reach, keep);
-    });
+    };
+    for (int k = 0; k < n_cells; ++k) visit(cells[k], shifts[k]);
     for (const auto& [j, shift] : near_) {
       const Vec3 d = obb_[j].centre + shift - ci;
       if (overlap(i, j, image ? box.near_image(d) : d)) lists_.add(i, j), lists_.add(j, i);
     }
   }
 
+  static constexpr int kWalkHintBlocks = 2;  // link's hint: blocks of four members a cell
   // A species of a mixture at scale 1.
   struct Kind {
     AnyShape shape;
