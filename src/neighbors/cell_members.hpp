@@ -66,11 +66,13 @@ class CellMembers {
   }
   std::uint32_t size(std::uint32_t cell) const { return size_[cell]; }
   // A hint: a cell's size and its first `blocks` blocks of four members (with their boxes'
-  // blocks, `boxes`), ahead of a walk. always_inline: a const function of prefetches alone is
-  // found pure by GCC and its calls deleted (system/simulation.hpp, prefetch_neighbors).
+  // blocks, `boxes`; at most the cell's capacity), ahead of a walk. always_inline: a const
+  // function of prefetches alone is found pure by GCC and its calls deleted
+  // (system/simulation.hpp, prefetch_neighbors).
   [[gnu::always_inline]] void prefetch(std::uint32_t cell, int blocks, bool boxes) const {
     __builtin_prefetch(&size_[cell]);
     const Pair* p = data_.data() + std::size_t(cell) * (cap_ / kLanes);
+    blocks = std::min(blocks, int(cap_ / kLanes));
     for (int k = 0; k < blocks; ++k) {
       __builtin_prefetch(&p[k].m);
       if (boxes) __builtin_prefetch(&p[k].h);

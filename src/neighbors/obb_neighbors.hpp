@@ -563,7 +563,9 @@ class ObbNeighbors {
       cells[n_cells] = c, shifts[n_cells] = shift, ++n_cells;
     });
     for (int k = 0; k < n_cells; ++k) members_.prefetch(cells[k], kWalkHintBlocks, boxes_);
-    auto visit = [&](std::uint32_t c, const Vec3& shift) {
+    for (int k = 0; k < n_cells; ++k) {
+      const std::uint32_t c = cells[k];
+      const Vec3& shift = shifts[k];
       auto keep = [&](std::uint32_t j) {
         if (!take(j)) return;
         __builtin_prefetch(&obb_[j]);
@@ -573,8 +575,7 @@ class ObbNeighbors {
       // j's centre minus ci - shift: the centre separation
       if (boxes_) members_.for_each_within_box(c, Vec3(ci - shift), fold, reach, half, keep);
       else members_.for_each_within(c, Vec3(ci - shift), fold, reach, keep);
-    };
-    for (int k = 0; k < n_cells; ++k) visit(cells[k], shifts[k]);
+    }
     for (const auto& [j, shift] : near_) {
       const Vec3 d = obb_[j].centre + shift - ci;
       if (overlap(i, j, image ? box.near_image(d) : d)) lists_.add(i, j), lists_.add(j, i);
