@@ -551,11 +551,11 @@ class ObbNeighbors {
     // i's axis-aligned box, widened like the reach by the centres' rounding (boxes_ only)
     const Vec3 half =
         boxes_ ? Vec3(aabb_half(obb_[i]).array() + members_.rounding_bound()) : Vec3::Zero();
-    // The stencil's cells first (at most 3 x 3 x 3), a hint for each cell's size and first two
-    // blocks of members (and their boxes), then the walk, cell by cell in the same order. At
-    // large N every cell's blocks miss; walked as they came, one cell's loads waited for the
-    // last's (measured at N = 256000: -8 % a collision; docs/benchmarks/README.md, "Session of
-    // 2026-12-08").
+    // The stencil's cells first (at most 3 x 3 x 3), a hint for each cell's size and first
+    // kWalkHintBlocks blocks of members (and their boxes), then the walk, cell by cell in the
+    // same order. At large N every cell's blocks miss; walked as they came, one cell's loads
+    // waited for the last's (measured at N = 256000: -8 % a collision with two blocks, a further
+    // -7 % with four; docs/benchmarks/README.md, "Session of 2026-12-08" and "2026-12-09").
     std::uint32_t cells[27];
     Vec3 shifts[27];
     int n_cells = 0;
@@ -582,7 +582,7 @@ class ObbNeighbors {
     }
   }
 
-  static constexpr int kWalkHintBlocks = 2;  // link's hint: blocks of four members a cell
+  static constexpr int kWalkHintBlocks = 4;  // link's hint: blocks of four members a cell
   // A species of a mixture at scale 1.
   struct Kind {
     AnyShape shape;
