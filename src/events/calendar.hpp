@@ -110,8 +110,18 @@ class Calendar {
     return heap_[0].id;
   }
 
-  // Re-place every slot with buckets of a new width (O(N)).
-  void set_width(double width) { rebuild(width); }
+  // Re-place every slot (O(N)) with buckets of about kPerBucket slots, judged from their times:
+  // a slot's next event is some mean time tau after now, so about size() / tau of them happen
+  // per unit time (the width aimed at: kPerBucket tau / size()). For a calendar just filled
+  // (every slot set once): the width it starts with is only a guess, and until the turn of its
+  // lists ends (nb buckets later) nothing else re-tunes it. No change when no time is finite.
+  void tune_width(double now) {
+    double sum = 0.0;
+    std::size_t finite = 0;
+    for (std::uint32_t i = 0; i < n_; ++i)
+      if (slot_[i].time < kInf) sum += slot_[i].time - now, ++finite;
+    if (finite > 0 && sum > 0.0) rebuild(kPerBucket * (sum / double(finite)) / double(n_));
+  }
 
   // After top(): the tag of the top slot, read from the heap (no access to the slot).
   std::uint32_t top_tag() const { return heap_.empty() ? 0u : heap_[0].tag; }
@@ -123,7 +133,6 @@ class Calendar {
     for (std::size_t k = 1; k <= 2 && k < heap_.size(); ++k, ++m) slot[m] = heap_[k].id, tag[m] = heap_[k].tag;
     return m;
   }
-
   // A hint for large calendars, once per event: one more node of the next bucket's list is asked
   // for from memory.  Pouring a list into the heap follows its links, one cache miss after the
   // other when the slots are spread over a large memory; walked ahead one node per event, the
@@ -142,6 +151,7 @@ class Calendar {
 
   // How often the width was re-tuned and the idle buckets jumped (for the tests).
   std::uint64_t rebuilds() const { return rebuilds_; }
+  std::size_t heap_entries() const { return heap_.size(); }  // the sorted part's size
   std::uint64_t jumps() const { return jumps_; }
 
  private:

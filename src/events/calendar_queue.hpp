@@ -36,6 +36,9 @@ class CalendarQueue {
     ev_[e.owner] = e;
     cal_.set(e.owner, e.time);
   }
+  // After every slot was set (a new calendar, or one restored): buckets sized from the events'
+  // times (Calendar::tune_width). The pop order does not depend on them.
+  void tune(double now) { cal_.tune_width(now); }
   // Remove the event of slot i (it becomes "never").
   void clear(std::uint32_t i) {
     Event e;

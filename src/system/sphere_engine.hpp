@@ -125,13 +125,7 @@ class SphereEngine {
     const std::uint32_t lists = std::max<std::uint32_t>(16, std::uint32_t(n / 4));  // 2 B/sphere
     q_.reset(static_cast<std::uint32_t>(n), 1.0, lists, now);
     for (std::uint32_t i = 0; i < n; ++i) predict(i);
-    // Buckets of about Calendar::kPerBucket events: a sphere's next event is some mean time tau
-    // ahead, so N / tau events happen per unit time.
-    double sum = 0.0;
-    std::size_t finite = 0;
-    for (std::uint32_t i = 0; i < n; ++i)
-      if (q_.time_of(i) < kInf) sum += q_.time_of(i) - now, ++finite;
-    if (finite > 0 && sum > 0.0) q_.set_width(Calendar::kPerBucket * (sum / finite) / n);
+    q_.tune_width(now);  // buckets of about Calendar::kPerBucket events
     reorder_every_ = 16 * std::uint64_t(n);
     reorder();
     const std::size_t bytes = bytes_per_sphere() * n;

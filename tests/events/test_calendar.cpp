@@ -140,6 +140,57 @@ TEST(Calendar, OverflowInfinitiesAndIdleStretches) {
   EXPECT_GT(jumps, 0u);  // the jump over idle turns was taken
 }
 
+// A calendar filled under a width far too large (every slot lands in the sorted heap, and with
+// all times within the first bucket nothing re-tunes it) and then tuned from its times
+// (tune_width, what the generic loop does after its first predictions): buckets of about
+// kPerBucket slots, a small heap, and the pops of the linear scan.
+TEST(Calendar, TunedFromItsTimes) {
+  const std::uint32_t n = 4000;
+  const double tau = 2e-3;  // the slots' mean time ahead, far below the width 1 to start with
+  for (const bool tune : {false, true}) {
+    Calendar q;
+    q.reset(n, 1.0, n / 4, 0.0);
+    Brute b;
+    b.t.assign(n, Calendar::kInf);
+    pcg32 rng(31);
+    std::exponential_distribution<double> ex(1.0 / tau);
+    double sum = 0.0;
+    std::size_t finite = 0;
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const double t = i % 100 == 7 ? Calendar::kInf : ex(rng);
+      q.set(i, b.t[i] = t);
+      if (t < Calendar::kInf) sum += t, ++finite;
+    }
+    EXPECT_EQ(q.heap_entries(), finite);  // all finite times in bucket 0: one big heap
+    if (tune) {
+      q.tune_width(0.0);
+      EXPECT_DOUBLE_EQ(q.width(), Calendar::kPerBucket * (sum / double(finite)) / n);
+      EXPECT_EQ(q.rebuilds(), 1u);
+    }
+    std::size_t heap_sum = 0;
+    const int pops = 2 * int(n);  // past the end of one turn of the lists (tuned)
+    for (int k = 0; k < pops; ++k) {
+      const std::uint32_t top = q.top();
+      ASSERT_EQ(top, b.top()) << "pop " << k << (tune ? " (tuned)" : "");
+      heap_sum += q.heap_entries();
+      q.set(top, b.t[top] = b.t[top] + ex(rng));
+    }
+    const double mean_heap = double(heap_sum) / pops;
+    if (tune) {
+      EXPECT_LT(mean_heap, 4.0 * Calendar::kPerBucket);  // a bucket's worth, not the system
+      EXPECT_EQ(q.rebuilds(), 1u);                        // the tuned width holds
+    } else {
+      EXPECT_GT(mean_heap, n / 2.0);  // untuned: the whole system in the heap, every pop
+      EXPECT_EQ(q.rebuilds(), 0u);
+    }
+  }
+  Calendar all_inf;  // no finite time: nothing to judge from, the width stays
+  all_inf.reset(10, 0.5, 4, 0.0);
+  all_inf.tune_width(0.0);
+  EXPECT_EQ(all_inf.width(), 0.5);
+  EXPECT_EQ(all_inf.rebuilds(), 0u);
+}
+
 TEST(Calendar, NegativeTimes) {
   // a run that starts before time 0 (buckets of negative index, lists taken modulo nb)
   Calendar q;

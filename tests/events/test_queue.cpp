@@ -80,6 +80,34 @@ TEST(Queue, IndexedHeapPopsLikeBruteForce) { expect_pops_like_brute_force<Indexe
 // loop's queue.
 TEST(Queue, CalendarQueuePopsLikeBruteForce) { expect_pops_like_brute_force<CalendarQueue>(); }
 
+// Tuned after its first fill (what the generic loop does: Simulation::tune_queue), with every
+// time far within the width it starts with, the calendar still pops like the brute-force queue.
+TEST(Queue, TunedCalendarQueuePopsLikeBruteForce) {
+  const std::uint32_t n = 1000;
+  CalendarQueue q(n);
+  BruteQueue b(n);
+  std::vector<double> t(n);
+  pcg32 rng(17);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  auto set = [&](std::uint32_t i, double time) {
+    Event e;
+    e.owner = i;
+    e.partner = (i + 7) % n;
+    e.type = i % 3 == 0 ? EventType::Rebuild : EventType::Collision;
+    e.time = t[i] = time;
+    q.set(e);
+    b.set(e);
+  };
+  for (std::uint32_t i = 0; i < n; ++i) set(i, 0.01 * u(rng));
+  q.tune(0.0);
+  for (int k = 0; k < 5000; ++k) {
+    const Event e = q.top();
+    ASSERT_EQ(e.owner, b.top().owner) << "pop " << k;
+    ASSERT_EQ(e.time, b.top().time) << "pop " << k;
+    set(e.owner, e.time + 0.01 * u(rng));
+  }
+}
+
 TEST(Queue, PopsInNonDecreasingTimeOrder) {
   const std::uint32_t n = 500;
   IndexedHeap q(n);
