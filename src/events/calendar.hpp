@@ -133,6 +133,17 @@ class Calendar {
     for (std::size_t k = 1; k <= 2 && k < heap_.size(); ++k, ++m) slot[m] = heap_[k].id, tag[m] = heap_[k].tag;
     return m;
   }
+  // After top(): the slot that comes next unless a new time is set before it, with its tag, or
+  // false when the heap holds the top alone (the next slot is then in a later bucket's list).
+  // It is the earlier of the root's children: every slot in a list is in a later bucket than
+  // every slot in the heap.
+  bool next_slot(std::uint32_t& slot, std::uint32_t& tag) const {
+    if (heap_.size() < 2) return false;
+    const std::size_t k = heap_.size() > 2 && heap_[2] < heap_[1] ? 2 : 1;
+    slot = heap_[k].id, tag = heap_[k].tag;
+    return true;
+  }
+
   // A hint for large calendars, once per event: one more node of the next bucket's list is asked
   // for from memory.  Pouring a list into the heap follows its links, one cache miss after the
   // other when the slots are spread over a large memory; walked ahead one node per event, the

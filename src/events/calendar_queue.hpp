@@ -34,7 +34,8 @@ class CalendarQueue {
   // Replace the event of slot e.owner.
   void set(const Event& e) {
     ev_[e.owner] = e;
-    cal_.set(e.owner, e.time);
+    // the tag: the other body the event reads (a collision's partner), for next_event
+    cal_.set(e.owner, e.time, e.type == EventType::Collision ? e.partner : e.owner);
   }
   // After every slot was set (a new calendar, or one restored): buckets sized from the events'
   // times (Calendar::tune_width). The pop order does not depend on them.
@@ -50,6 +51,12 @@ class CalendarQueue {
   const Event& top() const { return ev_[cal_.top()]; }
   const Event& event_of(std::uint32_t i) const { return ev_[i]; }
   [[gnu::always_inline]] void prefetch(std::uint32_t i) const { __builtin_prefetch(&ev_[i]); }
+  // After top(): the event that comes next unless a new one is set before it (Calendar::
+  // next_slot), as its owner and the other body it reads (a collision's partner, else the owner
+  // again), from the calendar's heap alone; false if the calendar cannot tell. For hints.
+  bool next_event(std::uint32_t& owner, std::uint32_t& other) const {
+    return cal_.next_slot(owner, other);
+  }
 
  private:
   std::vector<Event> ev_;

@@ -23,12 +23,20 @@ struct Brute {
       if (t[i] < t[b]) b = i;  // first of equal times: the lowest slot
     return b;
   }
+  // The least (time, slot) but `top`'s (n if there is no other).
+  std::uint32_t second(std::uint32_t top) const {
+    std::uint32_t b = static_cast<std::uint32_t>(t.size());
+    for (std::uint32_t i = 0; i < t.size(); ++i)
+      if (i != top && (b == t.size() || t[i] < t[b])) b = i;
+    return b;
+  }
 };
 
 // A discrete-event run: pop the top, give it a new time ahead, and move a few others; returns
 // the number of pops compared.  The tags and stamps set with the times must come back with them.
 struct Drive {
   int compared = 0;
+  int seconds = 0;  // pops where next_slot named the slot after the top
   std::uint64_t rebuilds = 0, jumps = 0;
 };
 Drive drive(std::uint32_t n, double width, std::uint32_t lists, std::uint64_t seed, int pops,
@@ -90,6 +98,14 @@ Drive drive(std::uint32_t n, double width, std::uint32_t lists, std::uint64_t se
           ADD_FAILURE() << "pop " << k << ": bad hint " << slot[c];
           return out;
         }
+      std::uint32_t next, next_tag;
+      if (q.next_slot(next, next_tag)) {  // the heap's second: the slot after the top, exactly
+        if (next != b.second(top) || next_tag != b.tag[next]) {
+          ADD_FAILURE() << "pop " << k << ": next_slot gave " << next << ", the scan " << b.second(top);
+          return out;
+        }
+        ++out.seconds;
+      }
     }
     if (b.t[top] == Calendar::kInf) {  // nothing finite ahead: revive a few
       for (int m = 0; m < 3; ++m) {
@@ -115,7 +131,9 @@ Drive drive(std::uint32_t n, double width, std::uint32_t lists, std::uint64_t se
 
 TEST(Calendar, PopsLikeALinearScan) {
   // width about right, too small and too large; few and many lists
-  EXPECT_EQ(drive(500, 0.02, 125, 1, 20000, 0.01, 0.01, 1.0).compared, 20000);
+  const Drive right = drive(500, 0.02, 125, 1, 20000, 0.01, 0.01, 1.0);
+  EXPECT_EQ(right.compared, 20000);
+  EXPECT_GT(right.seconds, 1000);  // next_slot answered, and was right, on many pops
   const Drive small = drive(500, 1e-6, 125, 2, 20000, 0.01, 0.01, 1.0);
   EXPECT_EQ(small.compared, 20000);
   EXPECT_GT(small.rebuilds, 0u);  // the width was re-tuned

@@ -81,7 +81,9 @@ TEST(Queue, IndexedHeapPopsLikeBruteForce) { expect_pops_like_brute_force<Indexe
 TEST(Queue, CalendarQueuePopsLikeBruteForce) { expect_pops_like_brute_force<CalendarQueue>(); }
 
 // Tuned after its first fill (what the generic loop does: Simulation::tune_queue), with every
-// time far within the width it starts with, the calendar still pops like the brute-force queue.
+// time far within the width it starts with, the calendar still pops like the brute-force queue;
+// and the event it names as the next one (next_event, the loop's hint) is the brute-force
+// queue's second, with the partner of a collision and the owner again for other events.
 TEST(Queue, TunedCalendarQueuePopsLikeBruteForce) {
   const std::uint32_t n = 1000;
   CalendarQueue q(n);
@@ -100,12 +102,23 @@ TEST(Queue, TunedCalendarQueuePopsLikeBruteForce) {
   };
   for (std::uint32_t i = 0; i < n; ++i) set(i, 0.01 * u(rng));
   q.tune(0.0);
+  int named = 0;
   for (int k = 0; k < 5000; ++k) {
     const Event e = q.top();
     ASSERT_EQ(e.owner, b.top().owner) << "pop " << k;
     ASSERT_EQ(e.time, b.top().time) << "pop " << k;
+    std::uint32_t next, other;
+    if (q.next_event(next, other)) {
+      std::uint32_t second = e.owner == 0 ? 1 : 0;
+      for (std::uint32_t i = 0; i < n; ++i)
+        if (i != e.owner && t[i] < t[second]) second = i;
+      ASSERT_EQ(next, second) << "pop " << k;
+      ASSERT_EQ(other, next % 3 == 0 ? next : (next + 7) % n) << "pop " << k;
+      ++named;
+    }
     set(e.owner, e.time + 0.01 * u(rng));
   }
+  EXPECT_GT(named, 1000);
 }
 
 TEST(Queue, PopsInNonDecreasingTimeOrder) {
