@@ -555,7 +555,7 @@ class ObbNeighbors {
     // kWalkHintBlocks blocks of members (and their boxes), then the walk, cell by cell in the
     // same order. At large N every cell's blocks miss; walked as they came, one cell's loads
     // waited for the last's (measured at N = 256000: -8 % a collision with two blocks, a further
-    // -7 % with four; docs/benchmarks/README.md, "Session of 2026-12-08" and "2026-12-09").
+    // -5 % with four; docs/benchmarks/README.md, both sessions of 2026-12-08).
     std::uint32_t cells[27];
     Vec3 shifts[27];
     int n_cells = 0;
