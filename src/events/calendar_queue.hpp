@@ -7,8 +7,11 @@
 // Why: IndexedHeap sifts through log2 N levels of a heap spread over memory on every set; at
 // N = 256000 ellipsoids that was 4 % of the run (perf), against below 1 % at N = 256. The
 // calendar sets a later event in O(1) (an unsorted list per time bucket) and keeps only the
-// current bucket sorted. Its bucket width adapts by itself (the calendar re-tunes it at the end
-// of each turn of its lists), so no time scale is needed here.
+// current bucket sorted. Its bucket width is judged from the events' times (tune(), which the
+// loop calls once every slot is set) and re-tuned at the end of each turn of its lists, so no
+// time scale is needed here. Untuned, a calendar whose events all fall within its first bucket
+// is one binary heap over all N (it was, for the generic loop, until the second session of
+// 2026-12-08).
 #pragma once
 #include <algorithm>
 #include <cstdint>
@@ -26,7 +29,8 @@ class CalendarQueue {
   void reset(std::uint32_t n) {
     ev_.assign(n, Event{});
     for (std::uint32_t i = 0; i < n; ++i) ev_[i].owner = i;
-    // the sphere loop's number of lists (a quarter of the slots, at least 16); width 1 to start
+    // the sphere loop's number of lists (a quarter of the slots, at least 16); width 1 to start,
+    // until tune() judges it from the first events' times
     cal_.reset(n, 1.0, std::max<std::uint32_t>(16, n / 4), 0.0);
   }
   std::uint32_t size() const { return static_cast<std::uint32_t>(ev_.size()); }
