@@ -329,7 +329,7 @@ class Simulation {
   // bodies' records, counter, box, list and memo. At large N each is a cache miss, and they came
   // one after another when the event was run (the slot, then the partner's counter, then the
   // records, then the lists); asked for a whole event ahead, they are at hand (measured at
-  // N = 256000 ellipsoids: -7 % a collision; N = 256 unchanged; docs/benchmarks/README.md,
+  // N = 256000 ellipsoids: -6 % a collision; N = 256 unchanged; docs/benchmarks/README.md,
   // "Second session of 2026-12-08").
   [[gnu::always_inline]] void prefetch_next_event() const {
     if constexpr (requires(std::uint32_t a, std::uint32_t b) { queue_.next_event(a, b); }) {
