@@ -71,7 +71,7 @@ class CellMembers {
   // (system/simulation.hpp, prefetch_neighbors).
   [[gnu::always_inline]] void prefetch(std::uint32_t cell, int blocks, bool boxes) const {
     __builtin_prefetch(&size_[cell]);
-    const Pair* p = data_.data() + std::size_t(cell) * (cap_ / kLanes);
+    const Pair* p = first_pair(cell);
     blocks = std::min(blocks, int(cap_ / kLanes));
     for (int k = 0; k < blocks; ++k) {
       __builtin_prefetch(&p[k].m);
@@ -102,7 +102,7 @@ class CellMembers {
   }
   void remove(std::uint32_t cell, std::uint32_t id) {
     const std::uint32_t n = size_[cell];
-    const Pair* b = data_.data() + std::size_t(cell) * (cap_ / kLanes);
+    const Pair* b = first_pair(cell);
     std::uint32_t k = 0;
     while (k < n && b[k / kLanes].m.id[k % kLanes] != id) ++k;
     if (k == n) throw std::logic_error("cell members: body not in its cell");
@@ -175,6 +175,9 @@ class CellMembers {
   const Pair& pair(std::uint32_t cell, std::uint32_t k) const {
     return data_[(std::size_t(cell) * cap_ + k) / kLanes];
   }
+  const Pair* first_pair(std::uint32_t cell) const {  // a cell's first block pair
+    return data_.data() + std::size_t(cell) * (cap_ / kLanes);
+  }
   void put(std::uint32_t cell, std::uint32_t k, const Member& m, const Half& h) {
     const std::size_t at = std::size_t(cell) * cap_ + k;
     const std::uint32_t l = k % kLanes;
@@ -209,7 +212,7 @@ class CellMembers {
     // fn is called for each, in the members' order.
     constexpr std::uint32_t kBuffer = 64;
     std::uint32_t pass[kBuffer];
-    const Pair* pb = data_.data() + std::size_t(cell) * (cap_ / kLanes);
+    const Pair* pb = first_pair(cell);
     const std::uint32_t n = size_[cell];
     for (std::uint32_t k = 0; k < n;) {
       const std::uint32_t stop = std::min(n, k + kBuffer);
